@@ -1,1 +1,160 @@
-// placeholder: being written
+#include "gauss_map.h"
+
+#include <morph/error.h>
+
+#include <string>
+
+namespace morph::detail {
+
+namespace {
+
+const auto kDet = [](const auto& a, const auto& b, const auto& c) { return det(a, b, c); };
+const auto kCrossDot = [](const auto& a, const auto& b, const auto& c, const auto& d) {
+  return cross_dot(a, b, c, d);
+};
+
+/// X lies on the closed arc (p, q), given that it lies on the great circle through them.
+bool between(const NormalRef& p, const NormalRef& x, const NormalRef& q) {
+  return filtered_sign(kCrossDot, p, x, p, q) >= 0 && filtered_sign(kCrossDot, x, q, p, q) >= 0;
+}
+
+/// Signs of det(N_fan[i], N_fan[i+1], p) for the slots of v's region, walking on at the
+/// first negative one. Returns the slot to cross, or -1 when p is in the closed region,
+/// with `zeros` holding the slots whose arc contains p.
+int region_test(const Polytope& P, int v, const NormalRef& p, int zeros[2], int& nzeros) {
+  const int b = P.fan_begin[v], n = P.fan_begin[v + 1] - b;
+  nzeros = 0;
+  for (int i = 0; i < n; ++i) {
+    const int s = orient(NormalRef{&P, P.fan_face[b + i]}, NormalRef{&P, P.fan_face[b + (i + 1 == n ? 0 : i + 1)]}, p);
+    if (s < 0) return i;
+    if (s == 0) {
+      if (nzeros == 2) throw error("internal error: a direction lies on three arcs of one region");
+      zeros[nzeros++] = i;
+    }
+  }
+  return -1;
+}
+
+Location classify(const Polytope& P, int v, const int zeros[2], int nzeros) {
+  const int b = P.fan_begin[v], n = P.fan_begin[v + 1] - b;
+  if (nzeros == 0) return {Location::Kind::vertex, v};
+  if (nzeros == 1) return {Location::Kind::edge, P.fan_edge[b + zeros[0]]};
+  // Two arcs: p is their common end, the normal of the facet between them.
+  const int i = zeros[0], j = zeros[1];
+  const int shared = (i + 1) % n == j ? j : i;  // slot i ends at fan_face[i+1]
+  return {Location::Kind::face, P.fan_face[b + shared]};
+}
+
+}  // namespace
+
+int orient(const NormalRef& a, const NormalRef& b, const NormalRef& c) { return filtered_sign(kDet, a, b, c); }
+
+Location locate(const Polytope& P, const NormalRef& p, int hint) {
+  int v = hint;
+  int zeros[2];
+  int nzeros = 0;
+  const int limit = P.num_vertices() + 16;
+  for (int steps = 0; steps < limit; ++steps) {
+    const int cross = region_test(P, v, p, zeros, nzeros);
+    if (cross < 0) return classify(P, v, zeros, nzeros);
+    v = P.fan_vertex[P.fan_begin[v] + cross];
+  }
+  // The walk climbs the support function and cannot loop on a polytope whose facets are
+  // exactly planar; on facets planar only within the tolerance it might, so fall back
+  // to testing every region.
+  for (v = 0; v < P.num_vertices(); ++v)
+    if (region_test(P, v, p, zeros, nzeros) < 0) return classify(P, v, zeros, nzeros);
+  throw error("internal error: a direction lies in no region of the Gauss map");
+}
+
+ArcContact arc_contact(const NormalRef& n1, const NormalRef& n2, const NormalRef& m1, const NormalRef& m2) {
+  ArcContact c;
+  const int s1 = orient(n1, n2, m1), s2 = orient(n1, n2, m2);
+  if (s1 == 0 && s2 == 0) {  // on one great circle: touching iff they overlap
+    c.touches = between(n1, m1, n2) || between(n1, m2, n2) || between(m1, n1, m2);
+    return c;
+  }
+  const int t1 = orient(m1, m2, n1), t2 = orient(m1, m2, n2);
+  if (s1 * s2 < 0 && t1 * t2 < 0) {
+    // The great circles meet at +-X; the arcs share X (not -X) iff t1 == -s1.
+    if (t1 == -s1) c.touches = c.crosses = true;
+    c.side = s2;
+    return c;
+  }
+  c.touches = (s1 == 0 && between(n1, m1, n2)) || (s2 == 0 && between(n1, m2, n2)) ||
+              (t1 == 0 && between(m1, n1, m2)) || (t2 == 0 && between(m1, n2, m2));
+  return c;
+}
+
+void arcs_around(const Polytope& P, const Location& where, std::vector<Arc>& out) {
+  out.clear();
+  switch (where.kind) {
+    case Location::Kind::vertex:
+      return;
+    case Location::Kind::edge: {
+      // Forward (toward the right facet) the region of `to` lies on the left.
+      const auto& e = P.edges[where.index];
+      out.push_back({NormalRef{&P, e.right}, e.to});
+      out.push_back({NormalRef{&P, e.left}, e.from});
+      return;
+    }
+    case Location::Kind::face: {
+      // Around N_f the arcs lead to the facets across f's edges; between the arcs toward
+      // the neighbours across edges k-1 and k lies the region of corner k.
+      const int f = where.index, d = P.degree(f), b = P.face_begin[f];
+      for (int k = 0; k < d; ++k) {
+        const auto& e = P.edges[P.corner_edge[b + k]];
+        const int across = e.left == f ? e.right : e.left;
+        out.push_back({NormalRef{&P, across}, P.corner_vertex[b + (k + 1 == d ? 0 : k + 1)]});
+      }
+      return;
+    }
+  }
+}
+
+void overlay_regions(const NormalRef& p, const std::vector<Arc>& x_arcs, const std::vector<Arc>& y_arcs,
+                     int y_region, std::vector<std::pair<int, int>>& out) {
+  const int nx = static_cast<int>(x_arcs.size()), ny = static_cast<int>(y_arcs.size());
+  if (ny == 0) {
+    for (int i = 0; i < nx; ++i) out.emplace_back(x_arcs[i].after, y_region);
+    return;
+  }
+  // Angles are measured counter-clockwise from the first x arc, by half-plane and then
+  // by orientation within it: half 0 is angle 0, 1 is (0, pi), 2 is pi, 3 is (pi, 2 pi).
+  const NormalRef& r = x_arcs[0].to;
+  auto half = [&](const NormalRef& q) {
+    const int s = orient(p, r, q);
+    if (s > 0) return 1;
+    if (s < 0) return 3;
+    return filtered_sign(kCrossDot, p, r, p, q) > 0 ? 0 : 2;
+  };
+  auto compare = [&](const NormalRef& q1, int h1, const NormalRef& q2, int h2) {
+    if (h1 != h2) return h1 < h2 ? -1 : 1;
+    if (h1 == 0 || h1 == 2) return 0;
+    return -orient(p, q1, q2);  // q1 before q2 when q2 is counter-clockwise of q1
+  };
+  std::vector<int> hx(nx), hy(ny);
+  for (int i = 0; i < nx; ++i) hx[i] = i == 0 ? 0 : half(x_arcs[i].to);
+  for (int j = 0; j < ny; ++j) hy[j] = half(y_arcs[j].to);
+  // The y arcs are cyclically sorted: start at the smallest angle.
+  int start = 0;
+  for (int j = 1; j < ny; ++j)
+    if (compare(y_arcs[j].to, hy[j], y_arcs[start].to, hy[start]) < 0) start = j;
+  int cur_x = x_arcs[nx - 1].after;
+  int cur_y = y_arcs[(start + ny - 1) % ny].after;
+  int i = 0, j = 0;
+  while (i < nx || j < ny) {
+    int c;
+    if (i == nx) c = 1;
+    else if (j == ny) c = -1;
+    else {
+      const int jj = (start + j) % ny;
+      c = compare(x_arcs[i].to, hx[i], y_arcs[jj].to, hy[jj]);
+    }
+    if (c <= 0) cur_x = x_arcs[i++].after;
+    if (c >= 0) cur_y = y_arcs[(start + j++) % ny].after;
+    out.emplace_back(cur_x, cur_y);
+  }
+}
+
+}  // namespace morph::detail

@@ -1,1 +1,347 @@
-// placeholder: being written
+#include "polytope.h"
+
+#include <morph/error.h>
+
+#include <mpfr.h>
+
+#include <algorithm>
+#include <numeric>
+#include <string>
+#include <unordered_map>
+
+namespace morph::detail {
+
+double round_to_nearest(const Exact& q) {
+  mpfr_t r;
+  mpfr_init2(r, 53);
+  mpfr_set_q(r, q.mpq(), MPFR_RNDN);
+  const double d = mpfr_get_d(r, MPFR_RNDN);
+  mpfr_clear(r);
+  return d;
+}
+
+const V3<Exact>& Polytope::exact_normal(int f) const {
+  ExactCache& cache = *exact_cache_;
+  std::call_once(cache.once[f], [&] {
+    const int b = face_begin[f];
+    std::vector<V3<Exact>> cycle;
+    cycle.reserve(degree(f));
+    for (int k = 0; k < degree(f); ++k) cycle.push_back(exact_point(corner_vertex[b + k]));
+    cache.value[f] = newell_normal<Exact>(degree(f), [&](int i) -> const V3<Exact>& { return cycle[i]; });
+  });
+  return cache.value[f];
+}
+
+void Polytope::compute_normals() {
+  const int nf = num_faces();
+  normals.resize(nf);
+  RoundingGuard guard;
+  std::vector<V3<Interval>> cycle;
+  for (int f = 0; f < nf; ++f) {
+    const int b = face_begin[f];
+    cycle.clear();
+    for (int k = 0; k < degree(f); ++k) cycle.push_back(interval_point(corner_vertex[b + k]));
+    normals[f] = newell_normal<Interval>(degree(f), [&](int i) -> const V3<Interval>& { return cycle[i]; });
+  }
+  exact_cache_ = std::make_shared<ExactCache>();
+  exact_cache_->once = std::make_unique<std::once_flag[]>(nf);
+  exact_cache_->value = std::make_unique<V3<Exact>[]>(nf);
+}
+
+namespace {
+
+std::uint64_t key(int u, int w) {
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(u)) << 32) | static_cast<std::uint32_t>(w);
+}
+
+/// The vector from vertex u to vertex w of a polytope, as a predicate argument.
+struct EdgeVector {
+  const Polytope* p;
+  int u, w;
+  V3<Interval> approx() const { return p->interval_point(w) - p->interval_point(u); }
+  V3<Exact> exact() const { return p->exact_point(w) - p->exact_point(u); }
+};
+
+struct UnionFind {
+  std::vector<int> parent;
+  explicit UnionFind(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  int find(int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  void unite(int a, int b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+};
+
+[[noreturn]] void fail(const char* name, const std::string& what) {
+  throw not_convex(std::string(name) + ": " + what);
+}
+
+/// Fills faces, edges and fans of `p` from facet cycles (vertex indices into p.points).
+/// The cycles must describe a closed, oriented 2-manifold.
+void build_connectivity(Polytope& p, const std::vector<std::vector<int>>& faces, const char* name) {
+  p.face_begin.assign(1, 0);
+  p.corner_vertex.clear();
+  for (const auto& cyc : faces) {
+    p.corner_vertex.insert(p.corner_vertex.end(), cyc.begin(), cyc.end());
+    p.face_begin.push_back(static_cast<int>(p.corner_vertex.size()));
+  }
+  const int nc = static_cast<int>(p.corner_vertex.size());
+  std::unordered_map<std::uint64_t, int> corner_of;  // directed edge -> corner where it starts
+  corner_of.reserve(nc * 2);
+  std::vector<int> corner_face(nc);
+  for (int f = 0; f < p.num_faces(); ++f) {
+    for (int k = 0; k < p.degree(f); ++k) {
+      const int c = p.face_begin[f] + k;
+      corner_face[c] = f;
+      const int u = p.corner_vertex[c];
+      const int w = p.corner(f, (k + 1) % p.degree(f));
+      if (!corner_of.emplace(key(u, w), c).second)
+        fail(name, "edge " + std::to_string(u) + "-" + std::to_string(w) + " is used twice in one direction");
+    }
+  }
+  auto next_corner = [&](int c) {
+    const int f = corner_face[c];
+    return c + 1 == p.face_begin[f + 1] ? p.face_begin[f] : c + 1;
+  };
+  auto prev_corner = [&](int c) {
+    const int f = corner_face[c];
+    return c == p.face_begin[f] ? p.face_begin[f + 1] - 1 : c - 1;
+  };
+  p.corner_edge.assign(nc, -1);
+  p.edges.clear();
+  for (int c = 0; c < nc; ++c) {
+    if (p.corner_edge[c] >= 0) continue;
+    const int u = p.corner_vertex[c], w = p.corner_vertex[next_corner(c)];
+    auto twin = corner_of.find(key(w, u));
+    if (twin == corner_of.end())
+      fail(name, "edge " + std::to_string(u) + "-" + std::to_string(w) + " has only one facet");
+    const int e = static_cast<int>(p.edges.size());
+    p.edges.push_back({u, w, corner_face[c], corner_face[twin->second]});
+    p.corner_edge[c] = e;
+    p.corner_edge[twin->second] = e;
+  }
+  // Fans: from facet f at v, the next facet counter-clockwise is the one across f's
+  // incoming edge u -> v, i.e. the facet holding v -> u.
+  const int nv = p.num_vertices();
+  std::vector<int> some_corner(nv, -1);
+  for (int c = 0; c < nc; ++c) some_corner[p.corner_vertex[c]] = c;
+  p.fan_begin.assign(nv + 1, 0);
+  p.fan_face.clear();
+  p.fan_edge.clear();
+  p.fan_vertex.clear();
+  for (int v = 0; v < nv; ++v) {
+    p.fan_begin[v] = static_cast<int>(p.fan_face.size());
+    const int start = some_corner[v];
+    if (start < 0) continue;
+    int c = start;
+    int guard = 0;
+    do {
+      const int u = p.corner_vertex[prev_corner(c)];
+      p.fan_face.push_back(corner_face[c]);
+      p.fan_edge.push_back(p.corner_edge[prev_corner(c)]);
+      p.fan_vertex.push_back(u);
+      c = corner_of.at(key(v, u));
+      if (++guard > nc) fail(name, "vertex " + std::to_string(v) + " has a broken fan");
+    } while (c != start);
+  }
+  p.fan_begin[nv] = static_cast<int>(p.fan_face.size());
+  // A vertex whose facets form several fans is not manifold.
+  std::vector<int> count(nv, 0);
+  for (int c = 0; c < nc; ++c) ++count[p.corner_vertex[c]];
+  for (int v = 0; v < nv; ++v)
+    if (count[v] != p.fan_begin[v + 1] - p.fan_begin[v])
+      fail(name, "vertex " + std::to_string(v) + " is not manifold");
+}
+
+int edge_convexity(const Polytope& p, const Polytope::Edge& e) {
+  return filtered_sign([](const auto& a, const auto& b, const auto& d) { return det(a, b, d); },
+                       NormalRef{&p, e.left}, NormalRef{&p, e.right}, EdgeVector{&p, e.from, e.to});
+}
+
+}  // namespace
+
+Polytope make_polytope(std::vector<V3<double>> points, std::vector<V3<Exact>> exact_points,
+                       const std::vector<std::vector<int>>& input_faces, const char* name) {
+  std::vector<std::vector<int>> faces = input_faces;
+  std::vector<int> face_source(faces.size());
+  std::iota(face_source.begin(), face_source.end(), 0);
+  Polytope p;
+  p.points = std::move(points);
+  p.exact_points = std::move(exact_points);
+  for (int round = 0;; ++round) {
+    build_connectivity(p, faces, name);
+    p.compute_normals();
+    UnionFind groups(p.num_faces());
+    bool merged = false;
+    {
+      RoundingGuard guard;
+      for (const auto& e : p.edges) {
+        if (edge_convexity(p, e) <= 0) {
+          groups.unite(e.left, e.right);
+          merged = true;
+        }
+      }
+    }
+    bool small_fan = false;
+    for (int v = 0; v < p.num_vertices() && !small_fan; ++v)
+      small_fan = p.fan_begin[v + 1] - p.fan_begin[v] < 3 && p.fan_begin[v + 1] > p.fan_begin[v];
+    if (!merged && !small_fan) break;
+    if (round > 8) fail(name, "facets do not settle into a convex polyhedron");
+    // Boundary of each group: the directed edges whose twin lies in another group.
+    const int nf = p.num_faces();
+    std::vector<int> group_of(nf);
+    for (int f = 0; f < nf; ++f) group_of[f] = groups.find(f);
+    std::unordered_map<std::uint64_t, int> next_of;  // (group, vertex) -> next vertex on the boundary
+    std::vector<int> start_of(nf, -1), boundary_count(nf, 0);
+    for (const auto& e : p.edges) {
+      const int gl = group_of[e.left], gr = group_of[e.right];
+      if (gl == gr) continue;
+      if (!next_of.emplace(key(gl, e.from), e.to).second || !next_of.emplace(key(gr, e.to), e.from).second)
+        fail(name, "merged coplanar facets around vertex " + std::to_string(e.from) + " do not form a disc");
+      start_of[gl] = e.from;
+      start_of[gr] = e.to;
+      ++boundary_count[gl];
+      ++boundary_count[gr];
+    }
+    // Vertices with fewer than three distinct groups around them are not vertices of
+    // the polyhedron (they lie inside an edge or a facet).
+    std::vector<char> keep(p.num_vertices(), 0);
+    for (int v = 0; v < p.num_vertices(); ++v) {
+      int distinct = 0;
+      int first = -1, second = -1;
+      for (int s = p.fan_begin[v]; s < p.fan_begin[v + 1]; ++s) {
+        const int g = group_of[p.fan_face[s]];
+        if (g == first || g == second) continue;
+        if (first < 0) first = g;
+        else if (second < 0) second = g;
+        ++distinct;
+        if (distinct >= 3) break;
+      }
+      keep[v] = distinct >= 3;
+    }
+    std::vector<std::vector<int>> merged_faces;
+    std::vector<int> merged_source;
+    for (int f = 0; f < nf; ++f) {
+      if (group_of[f] != f) continue;
+      if (start_of[f] < 0) fail(name, "all facets are coplanar");
+      std::vector<int> cyc;
+      int v = start_of[f];
+      int steps = 0;
+      do {
+        if (keep[v]) cyc.push_back(v);
+        v = next_of.at(key(f, v));
+        if (++steps > static_cast<int>(p.corner_vertex.size()))
+          fail(name, "merged facet " + std::to_string(face_source[f]) + " has a broken boundary");
+      } while (v != start_of[f]);
+      if (steps != boundary_count[f])
+        fail(name, "coplanar facets around facet " + std::to_string(face_source[f]) + " do not form a disc");
+      if (cyc.size() < 3) fail(name, "facet " + std::to_string(face_source[f]) + " degenerates when merged");
+      merged_faces.push_back(std::move(cyc));
+      merged_source.push_back(face_source[f]);
+    }
+    faces = std::move(merged_faces);
+    face_source = std::move(merged_source);
+  }
+  // Drop unused vertices.
+  std::vector<int> new_index(p.num_vertices(), -1);
+  int used = 0;
+  for (const auto& cyc : faces)
+    for (int v : cyc)
+      if (new_index[v] < 0) new_index[v] = used++;
+  if (used != p.num_vertices()) {
+    std::vector<V3<double>> pts(used);
+    std::vector<V3<Exact>> epts(p.exact_points.empty() ? 0 : used);
+    std::vector<int> vsrc(used);
+    for (int v = 0; v < p.num_vertices(); ++v) {
+      if (new_index[v] < 0) continue;
+      pts[new_index[v]] = p.points[v];
+      if (!epts.empty()) epts[new_index[v]] = p.exact_points[v];
+      vsrc[new_index[v]] = v;
+    }
+    for (auto& cyc : faces)
+      for (int& v : cyc) v = new_index[v];
+    p.points = std::move(pts);
+    p.exact_points = std::move(epts);
+    p.vertex_source = std::move(vsrc);
+    build_connectivity(p, faces, name);
+    p.compute_normals();
+  } else {
+    p.vertex_source.resize(used);
+    std::iota(p.vertex_source.begin(), p.vertex_source.end(), 0);
+  }
+  p.face_source = face_source;
+  p.edge_source.assign(p.num_edges(), -1);
+  // The Gauss map must be valid: the normals around every vertex turn strictly
+  // counter-clockwise (a convex spherical polygon).
+  RoundingGuard guard;
+  for (int v = 0; v < p.num_vertices(); ++v) {
+    const int b = p.fan_begin[v], n = p.fan_begin[v + 1] - b;
+    if (n < 3) fail(name, "vertex " + std::to_string(p.vertex_source[v]) + " has fewer than three facets");
+    for (int i = 0; i < n; ++i) {
+      const int s = filtered_sign([](const auto& a, const auto& c, const auto& d) { return det(a, c, d); },
+                                  NormalRef{&p, p.fan_face[b + i]}, NormalRef{&p, p.fan_face[b + (i + 1) % n]},
+                                  NormalRef{&p, p.fan_face[b + (i + 2) % n]});
+      if (s <= 0)
+        fail(name, "the facets around vertex " + std::to_string(p.vertex_source[v]) +
+                       " do not turn convexly (the mesh is not convex)");
+    }
+  }
+  for (const auto& e : p.edges)
+    if (edge_convexity(p, e) <= 0)
+      fail(name, "edge " + std::to_string(p.vertex_source[e.from]) + "-" + std::to_string(p.vertex_source[e.to]) +
+                     " is not convex");
+  return p;
+}
+
+Polytope make_polytope(const Mesh& mesh, const char* name) {
+  std::vector<V3<double>> points;
+  points.reserve(mesh.n_vertices());
+  for (auto v : mesh.vertices()) {
+    const auto& q = mesh.point(v);
+    points.push_back({q[0], q[1], q[2]});
+  }
+  std::vector<std::vector<int>> faces;
+  faces.reserve(mesh.n_faces());
+  for (auto f : mesh.faces()) {
+    std::vector<int> cyc;
+    for (auto v : f.vertices()) cyc.push_back(v.idx());
+    faces.push_back(std::move(cyc));
+  }
+  Polytope p = make_polytope(std::move(points), {}, faces, name);
+  for (int e = 0; e < p.num_edges(); ++e) {
+    const int u = p.vertex_source[p.edges[e].from], w = p.vertex_source[p.edges[e].to];
+    auto h = mesh.find_halfedge(mesh.vertex_handle(u), mesh.vertex_handle(w));
+    if (!h.is_valid()) {
+      // The polytope edge spans removed vertices: label it with its first mesh edge.
+      for (auto oh : mesh.voh_range(mesh.vertex_handle(u))) {
+        if (mesh.face_handle(oh).is_valid() && mesh.face_handle(oh).idx() == p.face_source[p.edges[e].left]) {
+          h = oh;
+          break;
+        }
+      }
+    }
+    p.edge_source[e] = h.is_valid() ? mesh.edge_handle(h).idx() : -1;
+  }
+  return p;
+}
+
+Mesh to_mesh(const Polytope& p) {
+  Mesh mesh;
+  std::vector<Mesh::VertexHandle> vh;
+  vh.reserve(p.num_vertices());
+  for (const auto& q : p.points) vh.push_back(mesh.add_vertex(Point(q.x, q.y, q.z)));
+  std::vector<Mesh::VertexHandle> face;
+  for (int f = 0; f < p.num_faces(); ++f) {
+    face.clear();
+    for (int k = 0; k < p.degree(f); ++k) face.push_back(vh[p.corner(f, k)]);
+    if (!mesh.add_face(face).is_valid())
+      throw error("internal error: facet " + std::to_string(f) + " of a result could not be added to the mesh");
+  }
+  return mesh;
+}
+
+}  // namespace morph::detail

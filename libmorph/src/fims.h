@@ -1,0 +1,46 @@
+// Private: the FIMS kernel proper, on Polytopes, and the assembly of its output.
+#pragma once
+
+#include <morph/minkowski_sum.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "polytope.h"
+
+namespace morph::detail {
+
+/// The facets of A (+) B as cycles of vertex pairs (i of A, j of B), counter-clockwise,
+/// with their origins; translated facets first (in A's facet order), then corner facets
+/// (B's facet order), then edge facets (A's edge order, then B's).
+struct SumFacets {
+  std::vector<int> face_begin{0};
+  std::vector<std::uint64_t> corners;  // (i << 32) | j
+  std::vector<FacetOrigin> origins;
+  int num_faces() const { return static_cast<int>(face_begin.size()) - 1; }
+};
+
+inline std::uint64_t pair_key(int i, int j) {
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(i)) << 32) | static_cast<std::uint32_t>(j);
+}
+inline int pair_first(std::uint64_t k) { return static_cast<int>(k >> 32); }
+inline int pair_second(std::uint64_t k) { return static_cast<int>(k & 0xffffffffu); }
+
+/// Computes the facets of A (+) B. Runs in the calling TBB arena.
+SumFacets fims_facets(const Polytope& A, const Polytope& B);
+
+/// The rounded result as a mesh: vertex i + j at the correctly rounded sum. Vertices
+/// that round to the same point are merged (see docs/algorithm.md, "below double
+/// precision"); facets left with fewer than three vertices are dropped.
+LabelledMesh sum_mesh(const Polytope& A, const Polytope& B, const SumFacets& facets);
+
+/// The exact result as a polytope (exact vertex sums), for chaining operations.
+Polytope sum_polytope(const Polytope& A, const Polytope& B, const SumFacets& facets);
+
+/// Builds a mesh from rounded points and facet cycles, merging points that round to the
+/// same place and dropping facets that degenerate; `keep` (optional, one per facet)
+/// receives whether each facet survived.
+Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& face_begin,
+                const std::vector<int>& corners, std::vector<char>* keep);
+
+}  // namespace morph::detail

@@ -1,0 +1,52 @@
+// Private: exact queries on the Gauss map of a Polytope (see polytope.h): locating a
+// direction, classifying how two arcs meet, and the angular order of arcs around a
+// point. These are the only geometric decisions of the FIMS kernel.
+#pragma once
+
+#include "polytope.h"
+
+namespace morph::detail {
+
+/// The feature of a Gauss map that contains a direction.
+struct Location {
+  enum class Kind : unsigned char { vertex, edge, face };
+  Kind kind = Kind::vertex;
+  int index = -1;
+};
+
+/// Sign of det(a, b, c) for three normals.
+int orient(const NormalRef& a, const NormalRef& b, const NormalRef& c);
+
+/// Locates the direction `p` in P's Gauss map: the vertex whose region contains it in
+/// its interior (the contributing vertex), the edge whose arc contains it, or the facet
+/// whose normal has its direction. The walk starts at vertex `hint` and climbs the
+/// support function; it is exact. Expected O(distance walked).
+Location locate(const Polytope& P, const NormalRef& p, int hint);
+
+/// How the arc (n1, n2) meets the arc (m1, m2) (both shorter than a half circle).
+struct ArcContact {
+  bool touches = false;  // the closed arcs share a point
+  bool crosses = false;  // they cross at a point interior to both
+  int side = 0;          // when crossing: sign of det(n1, n2, m2) (where m2 lies)
+};
+ArcContact arc_contact(const NormalRef& n1, const NormalRef& n2, const NormalRef& m1, const NormalRef& m2);
+
+/// An arc of a Gauss map leaving a point, toward the normal `to`, followed
+/// counter-clockwise by the region of vertex `after`.
+struct Arc {
+  NormalRef to;
+  int after;
+};
+
+/// The arcs of P's Gauss map around a point lying on the given feature, counter-clockwise.
+/// A vertex region has none.
+void arcs_around(const Polytope& P, const Location& where, std::vector<Arc>& out);
+
+/// The regions around the point `p` after overlaying two maps: x_arcs (non-empty,
+/// counter-clockwise) and y_arcs (counter-clockwise, possibly empty, in which case the
+/// point lies inside the region y_region). Appends (x vertex, y vertex) pairs,
+/// counter-clockwise, one per distinct arc direction.
+void overlay_regions(const NormalRef& p, const std::vector<Arc>& x_arcs, const std::vector<Arc>& y_arcs,
+                     int y_region, std::vector<std::pair<int, int>>& out);
+
+}  // namespace morph::detail

@@ -1,0 +1,31 @@
+// Private: the one place libmorph touches TBB. Loops run sequentially below a cut-off,
+// and every loop body that evaluates predicates sets its own rounding mode.
+#pragma once
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+namespace morph::detail {
+
+/// Runs f() with at most `threads` worker threads (0: all cores).
+template <class F>
+auto run_with_threads(int threads, F&& f) {
+  if (threads <= 0) return f();
+  tbb::task_arena arena(threads);
+  return arena.execute(std::forward<F>(f));
+}
+
+/// Calls body(begin, end) over [0, n) in chunks of about `grain`, in parallel when n is
+/// large enough to pay for it.
+template <class Body>
+void parallel_chunks(int n, int grain, const Body& body) {
+  if (n <= grain) {
+    if (n > 0) body(0, n);
+    return;
+  }
+  tbb::parallel_for(tbb::blocked_range<int>(0, n, grain),
+                    [&](const tbb::blocked_range<int>& r) { body(r.begin(), r.end()); });
+}
+
+}  // namespace morph::detail

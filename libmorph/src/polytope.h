@@ -1,0 +1,108 @@
+// Private: the kernel's view of a convex polyhedron.
+//
+// A Polytope is built from a validated Mesh (or produced by an operation) and carries
+// what the exact algorithms need: facet cycles, edges with their two facets, the fan of
+// facets around each vertex, interval and (lazily) exact facet normals, and exact vertex
+// positions when they are not doubles (results of an erosion chained into a dilation).
+//
+// Canonical form: adjacent facets whose common edge is not strictly convex (exactly
+// coplanar, or within the validation tolerance) are merged into one polygon, and
+// vertices left with fewer than three distinct facets around them (in the middle of an
+// edge or of a facet) are removed. The normal of a facet is Newell's normal of its
+// exact vertex cycle, so every decision made on normals is exact and consistent.
+//
+// The Gauss map of a polytope: facet f -> point N_f on the sphere; edge -> the arc from
+// N_left to N_right; vertex v -> the convex spherical polygon of the normals of the facets
+// around it, listed counter-clockwise (seen from outside) in its fan.
+#pragma once
+
+#include <morph/mesh.h>
+
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "exact.h"
+
+namespace morph::detail {
+
+struct Polytope {
+  struct Edge {
+    int from = -1, to = -1;    // vertices; `left` contains the directed edge from -> to
+    int left = -1, right = -1;  // facets
+  };
+
+  // Vertices: rounded positions, and exact ones when they are not doubles.
+  std::vector<V3<double>> points;
+  std::vector<V3<Exact>> exact_points;  // empty when `points` are exact
+
+  // Facets: counter-clockwise vertex cycles about the outward normal.
+  std::vector<int> face_begin;     // size F + 1
+  std::vector<int> corner_vertex;  // corner k of facet f: corner_vertex[face_begin[f] + k]
+  std::vector<int> corner_edge;    // edge from corner k to corner k + 1 (index into `edges`)
+
+  std::vector<Edge> edges;
+
+  // Fans: facets around vertex v counter-clockwise seen from outside. Slot s lies
+  // between fan_face[s] and fan_face[s + 1] (cyclically) and is the edge fan_edge[s]
+  // from v to fan_vertex[s]; crossing that arc of the Gauss map leads to fan_vertex[s].
+  std::vector<int> fan_begin;  // size V + 1
+  std::vector<int> fan_face, fan_edge, fan_vertex;
+
+  // Interval Newell normals (computed under a RoundingGuard).
+  std::vector<V3<Interval>> normals;
+
+  // Where each element came from in the operand mesh (labels): a representative face,
+  // the vertex, a representative edge. -1 when not from a mesh.
+  std::vector<int> face_source, vertex_source, edge_source;
+
+  int num_vertices() const { return static_cast<int>(points.size()); }
+  int num_faces() const { return static_cast<int>(face_begin.size()) - 1; }
+  int num_edges() const { return static_cast<int>(edges.size()); }
+  int degree(int f) const { return face_begin[f + 1] - face_begin[f]; }
+  int corner(int f, int k) const { return corner_vertex[face_begin[f] + k]; }
+
+  V3<Exact> exact_point(int v) const {
+    return exact_points.empty() ? to_exact(points[v]) : exact_points[v];
+  }
+  V3<Interval> interval_point(int v) const {
+    return exact_points.empty() ? to_interval(points[v]) : to_interval(exact_points[v]);
+  }
+
+  /// Exact Newell normal of facet f, computed once on first use (thread-safe).
+  const V3<Exact>& exact_normal(int f) const;
+
+  /// Computes `normals` and resets the exact cache; call after the facets are final.
+  void compute_normals();
+
+ private:
+  struct ExactCache {
+    std::unique_ptr<std::once_flag[]> once;
+    std::unique_ptr<V3<Exact>[]> value;
+  };
+  mutable std::shared_ptr<ExactCache> exact_cache_;
+};
+
+/// A facet normal as a predicate argument (see filtered_sign).
+struct NormalRef {
+  const Polytope* polytope;
+  int face;
+  const V3<Interval>& approx() const { return polytope->normals[face]; }
+  const V3<Exact>& exact() const { return polytope->exact_normal(face); }
+};
+
+/// Builds the canonical polytope of a mesh that passed prepare_convex_polyhedron().
+/// Throws not_convex (prefixed with `name`) if the facets' exact normals do not form a
+/// valid Gauss map (possible only for meshes convex merely within the tolerance).
+Polytope make_polytope(const Mesh& mesh, const char* name);
+
+/// Builds a polytope from facet cycles over the given vertices (exact positions when
+/// `exact_points` is non-empty), canonicalising it as make_polytope does. Vertices not
+/// used by any facet are dropped.
+Polytope make_polytope(std::vector<V3<double>> points, std::vector<V3<Exact>> exact_points,
+                       const std::vector<std::vector<int>>& faces, const char* name);
+
+/// The mesh of a polytope (its rounded positions), with facets in polytope order.
+Mesh to_mesh(const Polytope& p);
+
+}  // namespace morph::detail
