@@ -132,8 +132,6 @@ void check_sum(const Mesh& A, const Mesh& B, const std::string& name) {
   if (exactly_planar(A) && exactly_planar(B)) {
     const std::string diff = compare_exact(got, want);
     CHECK_MESSAGE(diff.empty(), diff);
-    const std::string clean = clean_mesh_problem(S.mesh);
-    CHECK_MESSAGE(clean.empty(), clean);
   } else {
     // Approximately planar operands: vertices must still be exact sums; the bodies agree
     // within kApproxDistance; facets are not compared (the exact hull splits bent facets).
@@ -149,9 +147,9 @@ void check_sum(const Mesh& A, const Mesh& B, const std::string& name) {
     CHECK_MESSAGE(all_are_sums, "an output vertex is not a double sum a_i + b_j");
     const std::string diff = compare_close(got, want, kApproxDistance * bbox_diagonal(S.mesh), kApproxVolume);
     CHECK_MESSAGE(diff.empty(), diff);
-    const std::string clean = clean_mesh_problem(S.mesh, {.exact = false});
-    CHECK_MESSAGE(clean.empty(), clean);
   }
+  const std::string clean = clean_mesh_problem(S.mesh, clean_options_for(S.mesh, {&A, &B}));
+  CHECK_MESSAGE(clean.empty(), clean);
 }
 
 struct Pair {
@@ -409,6 +407,6 @@ TEST_CASE("fims: output is identical for any thread count") {
     }
     CHECK(same_origins);
   }
-  CHECK(clean_mesh_problem(one.mesh).empty());
+  CHECK(clean_mesh_problem(one.mesh, clean_options_for(one.mesh, {&A, &B})).empty());
   CHECK(origins_problem(one, A, B).empty());
 }

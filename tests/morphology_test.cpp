@@ -1,1 +1,430 @@
-// being written
+// The morphology layer (morphology.h): erosion against the exact half-space reference,
+// opening against the exact hull of (exact erosion) + B, and the laws of morphology on
+// convex sets, on samples, random polytopes and several structuring elements.
+#include "support/oracle.h"
+#include "support/polytopes.h"
+
+#include <morph/error.h>
+#include <morph/io.h>
+#include <morph/morphology.h>
+#include <morph/structuring_element.h>
+#include <morph/validate.h>
+
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace morph;
+using namespace morph::test;
+
+// A result rounded once from exact values: its vertices are within half an ulp of the
+// exact set, so containment and equality hold to this fraction of the diagonal.
+constexpr double kRoundedTol = 1e-12;
+// Two library calls chained through a rounded intermediate mesh: the second step sees
+// facet planes tilted by the first rounding, amplified by short edges.
+constexpr double kChainedTol = 1e-9;
+
+struct Named {
+  std::string name;
+  Mesh mesh;
+};
+
+// Structuring elements of about `size` (radius), several shapes, two away from the origin.
+std::vector<Named> elements(double size, std::uint64_t seed) {
+  const double s = size;
+  return {
+      {"icosphere level 1", make_icosphere(s, 1)},
+      {"icosphere level 2", make_icosphere(s, 2)},
+      {"box", make_box(s, 0.5 * s, 1.5 * s)},
+      {"rotated box (exact hull of its corners)", rotated_cube_triangles(s, seed)},
+      {"rotated box (bent quads)", rotated_cube_quads(s, seed + 1)},
+      {"tetrahedron", make_tetrahedron(s)},
+      {"integer-like tetrahedron", tetrahedron(0.5 * s)},
+      {"box away from the origin", translated(make_box(s, s, s), Point(1.5 * s, 0.25 * s, -2 * s))},
+      // Re-hulled after the (rounding) translation, so that it stays exactly convex.
+      {"hull away from the origin",
+       convex_hull_mesh(positions(translated(random_sphere_polytope(10, seed + 2, 0.5 * s), Point(0, 3 * s, s))))},
+  };
+}
+
+// Convex operands: random hulls of several kinds.
+std::vector<Named> operands() {
+  std::vector<Named> out;
+  for (std::uint64_t s = 1; s <= 3; ++s) {
+    out.push_back({"sphere hull " + std::to_string(s), random_sphere_polytope(20 + 10 * static_cast<int>(s), 40 + s)});
+    out.push_back({"integer hull " + std::to_string(s), scaled(random_integer_polytope(16, 50 + s, 3), 0.5)});
+    out.push_back({"cube hull " + std::to_string(s), random_cube_polytope(25, 60 + s)});
+  }
+  return out;
+}
+
+std::vector<Named> samples() {
+  std::vector<Named> out;
+  const std::filesystem::path dir = MORPH_SAMPLES_DIR;
+  if (!std::filesystem::is_directory(dir)) return out;
+  std::vector<std::filesystem::path> paths;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() == ".off") paths.push_back(entry.path());
+  }
+  std::sort(paths.begin(), paths.end());
+  for (const auto& path : paths) {
+    Mesh m = read_mesh(path);
+    if (m.n_vertices() > 400 || !check_convex_polyhedron(m).ok()) continue;  // quick, valid operands only
+    out.push_back({path.filename().string(), std::move(m)});
+  }
+  return out;
+}
+
+void check_clean(const MorphResult& r, const Mesh& A, const Mesh& B) {
+  REQUIRE_FALSE(r.is_empty());
+  const std::string problem = clean_mesh_problem(r.mesh, clean_options_for(r.mesh, {&A, &B}));
+  CHECK_MESSAGE(problem.empty(), problem);
+}
+
+// Runs `op` and checks it left its inputs alone.
+template <class Op>
+MorphResult run(Op op, const Mesh& A, const Mesh& B) {
+  const Mesh a_before = A, b_before = B;
+  MorphResult r = op(A, B, MorphologyOptions{});
+  CHECK_MESSAGE(identical(A, a_before), "A was modified");
+  CHECK_MESSAGE(identical(B, b_before), "B was modified");
+  return r;
+}
+MorphResult run_erode(const Mesh& A, const Mesh& B) {
+  return run([](const Mesh& a, const Mesh& b, const MorphologyOptions& o) { return morph::erode(a, b, o); }, A, B);
+}
+MorphResult run_dilate(const Mesh& A, const Mesh& B) {
+  return run([](const Mesh& a, const Mesh& b, const MorphologyOptions& o) { return morph::dilate(a, b, o); }, A, B);
+}
+MorphResult run_open(const Mesh& A, const Mesh& B) {
+  return run([](const Mesh& a, const Mesh& b, const MorphologyOptions& o) { return morph::open(a, b, o); }, A, B);
+}
+MorphResult run_close(const Mesh& A, const Mesh& B) {
+  return run([](const Mesh& a, const Mesh& b, const MorphologyOptions& o) { return morph::close(a, b, o); }, A, B);
+}
+
+// The result must be the exact set: same description (exactly for an exactly planar A,
+// whose facet planes are exact; else within tolerance), or the right kind of emptiness.
+void check_against(const MorphResult& r, const ExactSet& want, const Mesh& A, const Mesh& B) {
+  if (want.dimension < 3) {
+    CHECK(r.is_empty());
+    CHECK(r.empty_reason == (want.dimension < 0 ? EmptyReason::empty : EmptyReason::flat));
+    CHECK_FALSE(r.message.empty());
+    CHECK(r.mesh.n_vertices() == 0);
+    return;
+  }
+  check_clean(r, A, B);
+  const Description got = describe(r.mesh);
+  if (exactly_planar(A)) {
+    const std::string diff = compare_exact(got, want.description);
+    CHECK_MESSAGE(diff.empty(), diff);
+  } else {
+    const std::string diff = compare_close(got, want.description, kRoundedTol * bbox_diagonal(A), 1e-9);
+    CHECK_MESSAGE(diff.empty(), diff);
+  }
+}
+
+void check_erosion(const Mesh& A, const Mesh& B, const std::string& name) {
+  INFO("erode: ", name);
+  const MorphResult r = run_erode(A, B);
+  check_against(r, exact_erosion(A, B), A, B);
+  CHECK(r.origins.empty());
+}
+
+void check_opening(const Mesh& A, const Mesh& B, const std::string& name) {
+  INFO("open: ", name);
+  const MorphResult r = run_open(A, B);
+  const ExactSet want = exact_opening(A, B);
+  if (want.dimension < 3) {
+    // An empty erosion makes an empty opening; a flat one is the caller's documented
+    // "empty when the erosion is": either way there is no mesh.
+    if (want.dimension < 0) CHECK(r.empty_reason == EmptyReason::empty);
+    return;
+  }
+  check_against(r, want, A, B);
+  CHECK(r.origins.size() == r.mesh.n_faces());
+  const Description a = describe(A);
+  CHECK(max_excess(describe(r.mesh), a) <= kRoundedTol * bbox_diagonal(A));  // open(A) inside A
+}
+
+std::string same_body(const Mesh& got, const Mesh& want, double tol) {
+  return compare_close(describe(got), describe(want), tol * bbox_diagonal(want), tol * 100);
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------
+// The exact references themselves
+
+TEST_CASE("morph: oracle self-check on exact erosion and opening") {
+  const ExactSet cc = exact_erosion(cube(4.0), cube(2.0));
+  REQUIRE(cc.dimension == 3);
+  CHECK(compare_exact(cc.description, describe(cube(2.0))).empty());
+  CHECK(exact_erosion(box(Point(-1, -1, -0.5), Point(1, 1, 0.5)), cube(1.0)).dimension == 2);
+  CHECK(exact_erosion(box(Point(-1, -1, -0.5), Point(1, 1, 0.5)), cube(1.0)).vertices.size() == 4);
+  CHECK(exact_erosion(box(Point(-1, -0.5, -0.5), Point(1, 0.5, 0.5)), cube(1.0)).dimension == 1);
+  CHECK(exact_erosion(cube(1.0), cube(1.0)).dimension == 0);
+  CHECK(exact_erosion(cube(1.0), cube(1.5)).dimension == -1);
+  // Away from the origin: A (-) (B + t) = (A (-) B) - t.
+  const ExactSet moved = exact_erosion(cube(4.0), translated(cube(2.0), Point(0.5, 0, 0)));
+  CHECK(compare_exact(moved.description, describe(translated(cube(2.0), Point(-0.5, 0, 0)))).empty());
+  // Closing law through the exact hull: (A (+) B) (-) B = A.
+  for (std::uint64_t s = 1; s <= 3; ++s) {
+    const Mesh A = random_integer_polytope(14, 400 + s, 3);
+    const Mesh B = random_integer_polytope(8, 500 + s, 1);
+    std::vector<Point> sums;
+    for (auto va : A.vertices()) {
+      for (auto vb : B.vertices()) sums.push_back(A.point(va) + B.point(vb));
+    }
+    CHECK(compare_exact(exact_erosion(convex_hull_mesh(sums), B).description, describe(A)).empty());
+  }
+  // An opening by a cube of a box is the box; by a tetrahedron it cuts the corners.
+  const Mesh bx = box(Point(-2, -1, -1), Point(2, 1, 1));
+  CHECK(compare_exact(exact_opening(bx, cube(1.0)).description, describe(bx)).empty());
+  CHECK(exact_opening(bx, tetrahedron(0.5)).description.volume < 16.0);
+}
+
+// ---------------------------------------------------------------------------------------
+// Against the exact references
+
+TEST_CASE("morph: erosion equals the exact half-space intersection") {
+  for (const Named& a : operands()) {
+    for (const Named& b : elements(0.15, 7)) check_erosion(a.mesh, b.mesh, a.name + " by " + b.name);
+  }
+}
+
+TEST_CASE("morph: erosion and opening of the samples equal the exact references") {
+  const std::vector<Named> all = samples();
+  REQUIRE_MESSAGE(all.size() >= 3, "expected at least 3 small convex samples/*.off in ", MORPH_SAMPLES_DIR);
+  for (const Named& a : all) {
+    const double size = 0.1 * bbox_diagonal(a.mesh);
+    for (const Named& b : elements(size, 8)) {
+      check_erosion(a.mesh, b.mesh, a.name + " by " + b.name);
+      check_opening(a.mesh, b.mesh, a.name + " by " + b.name);
+    }
+  }
+}
+
+TEST_CASE("morph: opening equals the exact hull of the exact erosion plus B") {
+  for (const Named& a : operands()) {
+    for (const Named& b : elements(0.2, 9)) check_opening(a.mesh, b.mesh, a.name + " by " + b.name);
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// Laws
+
+TEST_CASE("morph: closing a convex polytope gives it back") {
+  for (const Named& a : operands()) {
+    const Description want = describe(a.mesh);
+    for (const Named& b : elements(0.2, 10)) {
+      INFO(a.name, " closed by ", b.name);
+      const MorphResult c = run_close(a.mesh, b.mesh);
+      check_clean(c, a.mesh, b.mesh);
+      const Description got = describe(c.mesh);
+      if (exactly_planar(b.mesh)) {
+        // Chained on exact values and rounded once: A's own vertices, exactly.
+        CHECK(got.vertices == want.vertices);
+        CHECK(got.facet_count == want.facet_count);
+        CHECK(got.facet_degrees() == want.facet_degrees());
+      } else {
+        // B's bent facets give A (+) B facets that are not exactly planar.
+        const std::string diff = compare_close(got, want, kRoundedTol * bbox_diagonal(a.mesh), 1e-9);
+        CHECK_MESSAGE(diff.empty(), diff);
+      }
+      // Idempotent.
+      const MorphResult cc = run_close(c.mesh, b.mesh);
+      check_clean(cc, c.mesh, b.mesh);
+      if (exactly_planar(b.mesh)) {
+        CHECK(describe(cc.mesh).vertices == want.vertices);
+      } else {
+        CHECK(same_body(cc.mesh, c.mesh, kChainedTol).empty());
+      }
+    }
+  }
+}
+
+TEST_CASE("morph: eroding a dilation gives A back") {
+  // Integer A and dyadic B: the dilation is exact in doubles, so the equality is exact.
+  for (std::uint64_t s = 1; s <= 4; ++s) {
+    const Mesh A = random_integer_polytope(15, 70 + s, 3);
+    for (const Mesh& B : {make_box(1.0, 0.5, 2.0), cube(1.0), tetrahedron(0.5),
+                          translated(make_box(0.5, 0.25, 1.0), Point(4, -2, 1))}) {
+      const MorphResult d = run_dilate(A, B);
+      check_clean(d, A, B);
+      CHECK(d.origins.size() == d.mesh.n_faces());
+      const MorphResult e = run_erode(d.mesh, B);
+      check_clean(e, A, B);
+      const std::string diff = compare_exact(describe(e.mesh), describe(A));
+      CHECK_MESSAGE(diff.empty(), diff);
+    }
+  }
+  // General doubles: the rounded dilation tilts facets by ulps.
+  for (const Named& a : operands()) {
+    for (const Named& b : elements(0.2, 11)) {
+      INFO(a.name, " dilated then eroded by ", b.name);
+      const MorphResult d = run_dilate(a.mesh, b.mesh);
+      const MorphResult e = run_erode(d.mesh, b.mesh);
+      check_clean(e, a.mesh, b.mesh);
+      const std::string diff = same_body(e.mesh, a.mesh, kChainedTol);
+      CHECK_MESSAGE(diff.empty(), diff);
+    }
+  }
+}
+
+TEST_CASE("morph: opening is inside A and idempotent; dilating an erosion stays inside A") {
+  for (const Named& a : operands()) {
+    const Description outer = describe(a.mesh);
+    const double diag = bbox_diagonal(a.mesh);
+    for (const Named& b : elements(0.2, 12)) {
+      INFO(a.name, " opened by ", b.name);
+      const MorphResult o = run_open(a.mesh, b.mesh);
+      check_clean(o, a.mesh, b.mesh);
+      CHECK(max_excess(describe(o.mesh), outer) <= kRoundedTol * diag);
+      const MorphResult oo = run_open(o.mesh, b.mesh);
+      check_clean(oo, a.mesh, b.mesh);
+      const std::string diff = same_body(oo.mesh, o.mesh, kChainedTol);
+      CHECK_MESSAGE(diff.empty(), diff);
+      const MorphResult e = run_erode(a.mesh, b.mesh);
+      const MorphResult de = run_dilate(e.mesh, b.mesh);
+      check_clean(de, a.mesh, b.mesh);
+      CHECK(max_excess(describe(de.mesh), outer) <= kChainedTol * diag);
+      // The chained pair agrees with the exactly chained opening.
+      CHECK(same_body(de.mesh, o.mesh, kChainedTol).empty());
+    }
+  }
+}
+
+TEST_CASE("morph: erosion and dilation are monotone in A") {
+  for (std::uint64_t s = 1; s <= 4; ++s) {
+    const Mesh A2 = random_sphere_polytope(40, 80 + s);
+    std::vector<Point> some = positions(A2);
+    some.resize(some.size() * 2 / 3);
+    const Mesh A1 = convex_hull_mesh(some);  // the hull of some of A2's vertices: A1 inside A2
+    for (const Named& b : elements(0.15, 13)) {
+      INFO("seed ", s, " by ", b.name);
+      const MorphResult e1 = run_erode(A1, b.mesh), e2 = run_erode(A2, b.mesh);
+      REQUIRE_FALSE(e2.is_empty());
+      if (!e1.is_empty()) {
+        CHECK(max_excess(describe(e1.mesh), describe(e2.mesh)) <= kRoundedTol * bbox_diagonal(A2));
+      }
+      const MorphResult d1 = run_dilate(A1, b.mesh), d2 = run_dilate(A2, b.mesh);
+      CHECK(max_excess(describe(d1.mesh), describe(d2.mesh)) <= kRoundedTol * bbox_diagonal(d2.mesh));
+    }
+  }
+}
+
+TEST_CASE("morph: operations commute with translation") {
+  const Point t(3, -2, 5);  // integer: A + t is exact for integer A
+  for (std::uint64_t s = 1; s <= 3; ++s) {
+    const Mesh A = random_integer_polytope(16, 90 + s, 3);
+    const Mesh At = translated(A, t);
+    for (const Named& b : elements(0.4, 14)) {
+      INFO("seed ", s, " by ", b.name);
+      // (A + t) (-) B = (A (-) B) + t and (A + t) (+) B = (A (+) B) + t; the same exact
+      // sets rounded at other places, so equal to rounding and with equal facet degrees.
+      const MorphResult e = run_erode(A, b.mesh), et = run_erode(At, b.mesh);
+      CHECK(same_body(et.mesh, translated(e.mesh, t), kRoundedTol).empty());
+      CHECK(describe(et.mesh).facet_degrees() == describe(e.mesh).facet_degrees());
+      const MorphResult o = run_open(A, b.mesh), ot = run_open(At, b.mesh);
+      CHECK(same_body(ot.mesh, translated(o.mesh, t), kRoundedTol).empty());
+      // A (-) (B + t) = (A (-) B) - t.
+      const MorphResult eb = run_erode(A, translated(b.mesh, t * 0.0625));
+      // (B + t is rounded, so only the bodies are compared: integer A has exactly
+      // degenerate vertices whose tiny eroded facets depend on ulps of B.)
+      CHECK(same_body(eb.mesh, translated(e.mesh, -t * 0.0625), kRoundedTol).empty());
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// Empty and flat results
+
+TEST_CASE("morph: an element larger than A erodes it to the empty set") {
+  const std::vector<std::pair<Mesh, Mesh>> cases = {
+      {cube(1.0), make_icosphere(1.0, 1)},
+      {random_sphere_polytope(20, 3, 0.5), cube(2.0)},
+      {make_tetrahedron(1.0), make_box(3.0, 0.1, 0.1)},
+      {cube(1.0), translated(cube(1.5), Point(7, 7, 7))},
+  };
+  for (const auto& [A, B] : cases) {
+    REQUIRE(exact_erosion(A, B).dimension == -1);
+    const MorphResult e = run_erode(A, B);
+    CHECK(e.is_empty());
+    CHECK(e.empty_reason == EmptyReason::empty);
+    CHECK_FALSE(e.message.empty());
+    CHECK(e.mesh.n_vertices() == 0);
+    const MorphResult o = run_open(A, B);
+    CHECK(o.is_empty());
+    CHECK(o.empty_reason == EmptyReason::empty);
+    CHECK_FALSE(o.message.empty());
+    CHECK(o.mesh.n_vertices() == 0);
+  }
+}
+
+TEST_CASE("morph: an element that fits only on a plane, a segment or a point gives a flat result") {
+  const Mesh unit = cube(1.0);
+  const std::vector<std::pair<std::string, Mesh>> cases = {
+      {"square", box(Point(-1, -1, -0.5), Point(1, 1, 0.5))},
+      {"segment", box(Point(-1, -0.5, -0.5), Point(1, 0.5, 0.5))},
+      {"point", cube(1.0)},
+      {"point, away from the origin", box(Point(4, 4, 4), Point(5, 5, 5))},
+  };
+  for (const auto& [name, A] : cases) {
+    INFO(name);
+    REQUIRE(exact_erosion(A, unit).dimension >= 0);
+    REQUIRE(exact_erosion(A, unit).dimension <= 2);
+    const MorphResult e = run_erode(A, unit);
+    CHECK(e.is_empty());
+    CHECK(e.empty_reason == EmptyReason::flat);
+    CHECK_FALSE(e.message.empty());
+    CHECK(e.mesh.n_vertices() == 0);
+  }
+  // Any body eroded by itself is the single point {0}.
+  const Mesh A = random_sphere_polytope(25, 5);
+  CHECK(exact_erosion(A, A).dimension == 0);
+  CHECK(run_erode(A, A).empty_reason == EmptyReason::flat);
+}
+
+// ---------------------------------------------------------------------------------------
+// Inputs, options and errors
+
+TEST_CASE("morph: results do not depend on the thread count") {
+  const Mesh A = random_sphere_polytope(120, 99);
+  const Mesh B = make_icosphere(0.1, 2);
+  for (auto op : {&morph::erode, &morph::dilate, &morph::open, &morph::close}) {
+    const MorphResult one = op(A, B, {.threads = 1});
+    const MorphResult two = op(A, B, {.threads = 2});
+    const MorphResult all = op(A, B, {.threads = 0});
+    CHECK(identical(one.mesh, two.mesh));
+    CHECK(identical(one.mesh, all.mesh));
+    CHECK(one.origins.size() == all.origins.size());
+  }
+}
+
+TEST_CASE("morph: a non-convex operand is rejected, naming it") {
+  // A tetrahedron whose bottom is dented in towards its apex.
+  const Mesh dented = mesh_from_polygons(
+      {Point(0, 0, 0), Point(2, 0, 0), Point(0, 2, 0), Point(0, 0, 2), Point(0.5, 0.5, 0.3)},
+      {{0, 1, 3}, {1, 2, 3}, {2, 0, 3}, {0, 2, 4}, {2, 1, 4}, {1, 0, 4}});
+  REQUIRE_FALSE(clean_mesh_problem(dented).empty());
+  for (auto op : {&morph::erode, &morph::dilate, &morph::open, &morph::close}) {
+    try {
+      (void)op(dented, cube(0.1), {});
+      FAIL("a non-convex A was accepted");
+    } catch (const invalid_mesh& e) {
+      CHECK(std::string(e.what()).find('A') != std::string::npos);
+    }
+    try {
+      (void)op(cube(1.0), dented, {});
+      FAIL("a non-convex B was accepted");
+    } catch (const invalid_mesh& e) {
+      CHECK(std::string(e.what()).find('B') != std::string::npos);
+    }
+  }
+}

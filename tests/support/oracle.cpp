@@ -72,6 +72,26 @@ Position rounded(const EPoint& p) {
 
 Position position(const Point& p) { return {p[0], p[1], p[2]}; }
 
+// The plane of a polygon by Newell's normal through its centroid; zero normal when the
+// polygon has no area.
+Plane newell_plane(const std::vector<Point>& p) {
+  Point n(0, 0, 0), centroid(0, 0, 0);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const Point& a = p[i];
+    const Point& b = p[(i + 1) % p.size()];
+    n += Point((a[1] - b[1]) * (a[2] + b[2]), (a[2] - b[2]) * (a[0] + b[0]), (a[0] - b[0]) * (a[1] + b[1]));
+    centroid += a;
+  }
+  centroid /= static_cast<double>(p.size());
+  const double len = n.norm();
+  if (len > 0) n /= len;
+  return {{n[0], n[1], n[2]}, OpenMesh::dot(n, centroid)};
+}
+
+double signed_distance(const Plane& h, const Point& p) {
+  return h.normal[0] * p[0] + h.normal[1] * p[1] + h.normal[2] * p[2] - h.offset;
+}
+
 // ---------------------------------------------------------------------------------------
 // Exact convex hull with polygon facets
 
@@ -336,21 +356,8 @@ Description describe(const Mesh& mesh) {
   for (auto f : mesh.faces()) {
     std::vector<Point> p;
     for (auto v : mesh.fv_range(f)) p.push_back(mesh.point(v));
-    Point n(0, 0, 0), centroid(0, 0, 0);
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      const Point& a = p[i];
-      const Point& b = p[(i + 1) % p.size()];
-      n[0] += (a[1] - b[1]) * (a[2] + b[2]);
-      n[1] += (a[2] - b[2]) * (a[0] + b[0]);
-      n[2] += (a[0] - b[0]) * (a[1] + b[1]);
-      centroid += a;
-    }
-    centroid /= static_cast<double>(p.size());
     for (std::size_t i = 1; i + 1 < p.size(); ++i) volume += OpenMesh::dot(p[0], OpenMesh::cross(p[i], p[i + 1]));
-    Plane plane;
-    const double len = n.norm();
-    for (int k = 0; k < 3; ++k) plane.normal[k] = len > 0 ? n[k] / len : 0.0;
-    plane.offset = plane.normal[0] * centroid[0] + plane.normal[1] * centroid[1] + plane.normal[2] * centroid[2];
+    const Plane plane = newell_plane(p);
     std::vector<Position> facet;
     for (const Point& q : p) facet.push_back(position(q));
     std::sort(facet.begin(), facet.end());
@@ -369,7 +376,10 @@ Description describe(const Mesh& mesh) {
   return d;
 }
 
-ErosionReference exact_erosion(const Mesh& A, const Mesh& B) {
+namespace {
+
+// The exact vertices of A (-) B (empty when B fits nowhere).
+std::vector<EPoint> erosion_points(const Mesh& A, const Mesh& B) {
   if (A.n_vertices() == 0 || B.n_vertices() == 0) throw std::invalid_argument("exact_erosion: empty operand");
   std::vector<QVec> b_points;
   for (auto v : B.vertices()) b_points.push_back(qvec(B.point(v)));
@@ -444,17 +454,43 @@ ErosionReference exact_erosion(const Mesh& A, const Mesh& B) {
     verts = std::move(next);
   }
 
-  ErosionReference ref;
   std::vector<EPoint> pts;
   for (const DDVertex& v : verts) {
     if (v.tight.front() < box_planes) throw std::logic_error("exact_erosion: result touches the bounding box");
     pts.emplace_back(EK::FT(v.p.x), EK::FT(v.p.y), EK::FT(v.p.z));
-    ref.vertices.push_back(rounded(pts.back()));
   }
-  std::sort(ref.vertices.begin(), ref.vertices.end());
-  ref.dimension = affine_dimension(pts);
-  if (ref.dimension == 3) ref.description = describe_hull(exact_hull(pts));
-  return ref;
+  return pts;
+}
+
+}  // namespace
+
+ExactSet exact_erosion(const Mesh& A, const Mesh& B) {
+  const std::vector<EPoint> pts = erosion_points(A, B);
+  ExactSet out;
+  for (const EPoint& p : pts) out.vertices.push_back(rounded(p));
+  std::sort(out.vertices.begin(), out.vertices.end());
+  out.dimension = affine_dimension(pts);
+  if (out.dimension == 3) out.description = describe_hull(exact_hull(pts));
+  return out;
+}
+
+ExactSet exact_opening(const Mesh& A, const Mesh& B) {
+  const std::vector<EPoint> pts = erosion_points(A, B);
+  ExactSet out;
+  out.dimension = affine_dimension(pts);
+  if (out.dimension < 0) return out;
+  std::vector<EPoint> sums;
+  for (const EPoint& p : pts) {
+    for (auto vb : B.vertices()) {
+      const Point& b = B.point(vb);
+      sums.emplace_back(p.x() + EK::FT(b[0]), p.y() + EK::FT(b[1]), p.z() + EK::FT(b[2]));
+    }
+  }
+  const ExactHull hull = exact_hull(sums);
+  for (const EPoint& p : hull.points) out.vertices.push_back(rounded(p));
+  std::sort(out.vertices.begin(), out.vertices.end());
+  if (out.dimension == 3) out.description = describe_hull(hull);
+  return out;
 }
 
 namespace {
@@ -572,7 +608,6 @@ bool identical(const Mesh& a, const Mesh& b) {
 }
 
 std::string clean_mesh_problem(const Mesh& mesh, const CleanOptions& options) {
-  std::ostringstream s;
   if (mesh.n_vertices() == 0 || mesh.n_faces() == 0) return "the mesh is empty";
   for (auto h : mesh.halfedges()) {
     if (mesh.is_boundary(h)) return "not closed: a boundary halfedge at vertex " + std::to_string(mesh.from_vertex_handle(h).idx());
@@ -632,7 +667,8 @@ std::string clean_mesh_problem(const Mesh& mesh, const CleanOptions& options) {
     const std::string name = "face " + std::to_string(f.idx());
     if (fv.size() < 3) return name + " has fewer than 3 vertices";
     std::vector<IPoint> p;
-    for (auto v : fv) p.push_back(ipoint(v));
+    std::vector<Point> pts;
+    for (auto v : fv) p.push_back(ipoint(v)), pts.push_back(mesh.point(v));
     for (std::size_t i = 0; i < p.size(); ++i) {
       for (std::size_t j = i + 1; j < p.size(); ++j) {
         if (p[i] == p[j]) return name + " repeats a vertex position";
@@ -642,22 +678,14 @@ std::string clean_mesh_problem(const Mesh& mesh, const CleanOptions& options) {
     while (j < p.size() && CGAL::collinear(p[0], p[1], p[j])) ++j;
     if (j == p.size()) return name + " has zero area";
     triple[f.idx()] = {p[0], p[1], p[j]};
-    // Newell plane, recomputed per face (describe() sorts its facets).
-    Point n(0, 0, 0), c(0, 0, 0);
-    for (std::size_t i = 0; i < fv.size(); ++i) {
-      const Point& a = mesh.point(fv[i]);
-      const Point& b = mesh.point(fv[(i + 1) % fv.size()]);
-      n += Point((a[1] - b[1]) * (a[2] + b[2]), (a[2] - b[2]) * (a[0] + b[0]), (a[0] - b[0]) * (a[1] + b[1]));
-      c += a;
-    }
+    const Plane h = newell_plane(pts);
+    const Point n(h.normal[0], h.normal[1], h.normal[2]);
     if (!(n.norm() > 0)) return name + " has zero area";
-    n.normalize();
-    c /= static_cast<double>(fv.size());
-    plane[f.idx()] = {{n[0], n[1], n[2]}, OpenMesh::dot(n, c)};
+    plane[f.idx()] = h;
     for (auto v : fv) {
       if (options.exact) {
         if (!CGAL::coplanar(p[0], p[1], p[j], ipoint(v))) return name + " is not exactly planar";
-      } else if (std::abs(OpenMesh::dot(n, mesh.point(v)) - plane[f.idx()].offset) > tol) {
+      } else if (std::abs(signed_distance(h, mesh.point(v))) > tol) {
         return name + " is not planar within the tolerance";
       }
     }
@@ -673,9 +701,7 @@ std::string clean_mesh_problem(const Mesh& mesh, const CleanOptions& options) {
       const auto& t = triple[f.idx()];
       return CGAL::orientation(t[0], t[1], t[2], ipoint(v)) == CGAL::POSITIVE;
     }
-    const Plane& h = plane[f.idx()];
-    const Point& p = mesh.point(v);
-    return h.normal[0] * p[0] + h.normal[1] * p[1] + h.normal[2] * p[2] - h.offset > tol;
+    return signed_distance(plane[f.idx()], mesh.point(v)) > tol;
   };
   auto coplanar_faces = [&](Mesh::FaceHandle f, Mesh::FaceHandle g) {
     for (auto v : mesh.fv_range(g)) {
@@ -683,9 +709,7 @@ std::string clean_mesh_problem(const Mesh& mesh, const CleanOptions& options) {
         const auto& t = triple[f.idx()];
         if (!CGAL::coplanar(t[0], t[1], t[2], ipoint(v))) return false;
       } else {
-        const Plane& h = plane[f.idx()];
-        const Point& p = mesh.point(v);
-        if (std::abs(h.normal[0] * p[0] + h.normal[1] * p[1] + h.normal[2] * p[2] - h.offset) > tol) return false;
+        if (std::abs(signed_distance(plane[f.idx()], mesh.point(v))) > tol) return false;
       }
     }
     return true;
@@ -695,6 +719,7 @@ std::string clean_mesh_problem(const Mesh& mesh, const CleanOptions& options) {
       if (above(f, v)) return "not convex: vertex " + std::to_string(v.idx()) + " above face " + std::to_string(f.idx());
     }
   }
+  if (!options.minimal) return {};
   for (auto e : mesh.edges()) {
     const auto f = mesh.face_handle(mesh.halfedge_handle(e, 0));
     const auto g = mesh.face_handle(mesh.halfedge_handle(e, 1));
@@ -712,7 +737,20 @@ std::string clean_mesh_problem(const Mesh& mesh, const CleanOptions& options) {
              " distinct face planes around it";
     }
   }
-  return s.str();
+  return {};
+}
+
+CleanOptions clean_options_for(const Mesh& result, const std::vector<const Mesh*>& operands) {
+  CleanOptions options;
+  if (exactly_planar(result)) return options;
+  options.exact = false;
+  for (const Mesh* m : operands) {
+    CleanOptions probe;
+    probe.exact = false;
+    const std::string problem = clean_mesh_problem(*m, probe);
+    if (problem.find("not minimal") != std::string::npos) options.minimal = false;
+  }
+  return options;
 }
 
 }  // namespace morph::test

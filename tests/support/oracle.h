@@ -47,15 +47,23 @@ Description exact_hull_of_sums(const Mesh& A, const Mesh& B);
 /// volume (divergence theorem, fan triangulation, in doubles); planes from Newell normals.
 Description describe(const Mesh& mesh);
 
-/// The exact erosion A (-) B = intersection over faces f of A of the half-space of f
-/// moved inwards by max_b <n_f, b>. Plane normals from three vertices of each face,
-/// exactly (for approximately planar faces, the three farthest-apart ones in turn).
-struct ErosionReference {
+/// An exactly computed set: its dimension, vertices (rounded to nearest, sorted) and,
+/// when solid, its description.
+struct ExactSet {
   int dimension = -1;              // -1 empty, 0 point, 1 segment, 2 polygon, 3 solid
-  std::vector<Position> vertices;  // rounded to nearest, sorted (also for flat results)
+  std::vector<Position> vertices;  // also for flat results
   Description description;         // when dimension == 3
 };
-ErosionReference exact_erosion(const Mesh& A, const Mesh& B);
+
+/// The exact erosion A (-) B = intersection over faces f of A of the half-space of f
+/// moved inwards by max_b <n_f, b> (own double-description clipping on exact rationals).
+/// Plane normals from three vertices of each face, exactly (for an exactly planar face
+/// any three give the same plane; for a bent one, the three spanning the largest area).
+ExactSet exact_erosion(const Mesh& A, const Mesh& B);
+
+/// The exact opening (A (-) B) (+) B: the hull of the exact erosion's vertices plus B's,
+/// rounded once. `dimension` is the erosion's; the description is set when it is 3.
+ExactSet exact_opening(const Mesh& A, const Mesh& B);
 
 /// First difference between two descriptions compared exactly (positions, facets as
 /// position sets, counts), volume to `volume_rel_tol`; empty when they agree.
@@ -77,9 +85,11 @@ bool exactly_planar(const Mesh& mesh);
 /// Options of the clean-mesh check.
 struct CleanOptions {
   /// true: planarity, convexity, coplanarity of neighbours decided exactly;
-  /// false: to `tolerance` times the bounding-box diagonal (approximately planar input).
+  /// false: to `tolerance` times the bounding-box diagonal (rounded or bent facets).
   bool exact = true;
-  double tolerance = 1e-9;
+  double tolerance = 1e-9;  // the library's own acceptance (kPlanarityTolerance)
+  /// Check minimality (no coplanar neighbours, >= 3 planes at every vertex).
+  bool minimal = true;
 };
 
 /// The first violation of "clean convex mesh", or empty: closed, 2-manifold, connected,
@@ -87,6 +97,13 @@ struct CleanOptions {
 /// and non-zero area, planar, convex, no two adjacent faces coplanar, every vertex has
 /// >= 3 distinct face planes around it, no duplicate vertex positions.
 std::string clean_mesh_problem(const Mesh& mesh, const CleanOptions& options = {});
+
+/// The strictest fair check of a computed result: exact when its faces are exactly
+/// planar; else (rounded vertices) to the tolerance, with minimality checked to the
+/// tolerance only when no operand has neighbours coplanar within it (an operand such as
+/// a triangulated rotated cube legitimately yields facets meeting at 1e-16 angles, and
+/// the exact oracle comparisons already decide minimality).
+CleanOptions clean_options_for(const Mesh& result, const std::vector<const Mesh*>& operands);
 
 /// The diagonal of the bounding box.
 double bbox_diagonal(const Mesh& mesh);
