@@ -4,6 +4,8 @@
 
 #include <string>
 
+#include "parallel.h"
+
 namespace morph::detail {
 
 namespace {
@@ -65,6 +67,31 @@ Location locate(const Polytope& P, const NormalRef& p, int hint) {
   for (v = 0; v < P.num_vertices(); ++v)
     if (region_test(P, v, p, zeros, nzeros) < 0) return classify(P, v, zeros, nzeros);
   throw error("internal error: a direction lies in no region of the Gauss map");
+}
+
+int location_vertex(const Polytope& P, const Location& loc) {
+  switch (loc.kind) {
+    case Location::Kind::vertex:
+      return loc.index;
+    case Location::Kind::edge:
+      return P.edges[loc.index].from;
+    case Location::Kind::face:
+      return P.corner(loc.index, 0);
+  }
+  return 0;
+}
+
+std::vector<Location> locate_all(const Polytope& from, const Polytope& in) {
+  std::vector<Location> loc(from.num_faces());
+  parallel_chunks(from.num_faces(), 256, [&](int begin, int end) {
+    RoundingGuard guard;
+    int hint = 0;
+    for (int f = begin; f < end; ++f) {
+      loc[f] = locate(in, NormalRef{&from, f}, hint);
+      hint = location_vertex(in, loc[f]);
+    }
+  });
+  return loc;
 }
 
 ArcContact arc_contact(const NormalRef& n1, const NormalRef& n2, const NormalRef& m1, const NormalRef& m2) {

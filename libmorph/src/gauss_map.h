@@ -23,6 +23,14 @@ int orient(const NormalRef& a, const NormalRef& b, const NormalRef& c);
 /// support function; it is exact. Expected O(distance walked).
 Location locate(const Polytope& P, const NormalRef& p, int hint);
 
+/// A vertex of the feature `loc` (the contributing vertex when it is a vertex region).
+int location_vertex(const Polytope& P, const Location& loc);
+
+/// Locates every facet normal of `from` in the Gauss map of `in`, in parallel, each walk
+/// starting from the previous facet's answer (facets near in index order are usually
+/// near on the sphere).
+std::vector<Location> locate_all(const Polytope& from, const Polytope& in);
+
 /// How the arc (n1, n2) meets the arc (m1, m2) (both shorter than a half circle).
 struct ArcContact {
   bool touches = false;  // the closed arcs share a point

@@ -20,34 +20,6 @@ namespace {
 
 constexpr int kGrain = 256;
 
-int location_hint(const Polytope& P, const Location& loc) {
-  switch (loc.kind) {
-    case Location::Kind::vertex:
-      return loc.index;
-    case Location::Kind::edge:
-      return P.edges[loc.index].from;
-    case Location::Kind::face:
-      return P.corner(loc.index, 0);
-  }
-  return 0;
-}
-
-/// Locates every facet normal of `from` in the Gauss map of `in`, walking from the
-/// previous facet's answer (facets that are neighbours in index order are usually
-/// neighbours on the sphere).
-std::vector<Location> locate_all(const Polytope& from, const Polytope& in) {
-  std::vector<Location> loc(from.num_faces());
-  parallel_chunks(from.num_faces(), kGrain, [&](int begin, int end) {
-    RoundingGuard guard;
-    int hint = 0;
-    for (int f = begin; f < end; ++f) {
-      loc[f] = locate(in, NormalRef{&from, f}, hint);
-      hint = location_hint(in, loc[f]);
-    }
-  });
-  return loc;
-}
-
 Element element_of(const Polytope& P, const Location& loc) {
   switch (loc.kind) {
     case Location::Kind::vertex:

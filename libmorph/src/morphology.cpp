@@ -1,1 +1,83 @@
-// placeholder: being written
+// Dilation, erosion, opening and closing on the exact kernel. Chained operations pass
+// exact polytopes from one step to the next and round once, at the end.
+#include <morph/morphology.h>
+
+#include <morph/validate.h>
+
+#include "fims.h"
+#include "halfspace_intersection.h"
+#include "parallel.h"
+
+namespace morph {
+
+namespace {
+
+using detail::Polytope;
+
+struct Operands {
+  Polytope a, b;
+};
+
+Operands prepare(const Mesh& A, const Mesh& B) {
+  const PreparedMesh a = prepare_convex_polyhedron(A, "A");
+  const PreparedMesh b = prepare_convex_polyhedron(B, "B");
+  return {detail::make_polytope(a.mesh, "A"), detail::make_polytope(b.mesh, "B")};
+}
+
+MorphResult empty_result(const detail::MaybePolytope& m) {
+  MorphResult r;
+  r.empty_reason = m.reason;
+  r.message = m.message;
+  return r;
+}
+
+MorphResult from_sum(const Polytope& a, const Polytope& b) {
+  LabelledMesh s = detail::sum_mesh(a, b, detail::fims_facets(a, b));
+  MorphResult r;
+  r.mesh = std::move(s.mesh);
+  r.origins = std::move(s.origins);
+  return r;
+}
+
+MorphResult from_polytope(const Polytope& p) {
+  MorphResult r;
+  std::vector<int> corners(p.corner_vertex.begin(), p.corner_vertex.end());
+  r.mesh = detail::clean_mesh(p.points, p.face_begin, corners, nullptr);
+  return r;
+}
+
+}  // namespace
+
+MorphResult dilate(const Mesh& A, const Mesh& B, const MorphologyOptions& options) {
+  return detail::run_with_threads(options.threads, [&] {
+    const Operands op = prepare(A, B);
+    return from_sum(op.a, op.b);
+  });
+}
+
+MorphResult erode(const Mesh& A, const Mesh& B, const MorphologyOptions& options) {
+  return detail::run_with_threads(options.threads, [&] {
+    const Operands op = prepare(A, B);
+    const detail::MaybePolytope e = detail::erode_polytope(op.a, op.b);
+    return e.polytope ? from_polytope(*e.polytope) : empty_result(e);
+  });
+}
+
+MorphResult open(const Mesh& A, const Mesh& B, const MorphologyOptions& options) {
+  return detail::run_with_threads(options.threads, [&] {
+    const Operands op = prepare(A, B);
+    const detail::MaybePolytope e = detail::erode_polytope(op.a, op.b);
+    return e.polytope ? from_sum(*e.polytope, op.b) : empty_result(e);
+  });
+}
+
+MorphResult close(const Mesh& A, const Mesh& B, const MorphologyOptions& options) {
+  return detail::run_with_threads(options.threads, [&] {
+    const Operands op = prepare(A, B);
+    const Polytope s = detail::sum_polytope(op.a, op.b, detail::fims_facets(op.a, op.b));
+    const detail::MaybePolytope e = detail::erode_polytope(s, op.b);
+    return e.polytope ? from_polytope(*e.polytope) : empty_result(e);
+  });
+}
+
+}  // namespace morph
