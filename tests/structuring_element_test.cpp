@@ -259,3 +259,48 @@ TEST_CASE("se: a spec naming a file reads and checks the mesh") {
   CHECK(m.n_faces() == 6);
   CHECK(morph::signed_volume(m) == doctest::Approx(1.0).epsilon(1e-15));
 }
+
+TEST_CASE("se: committed samples read back exactly and are convex polyhedra") {
+  const std::filesystem::path directory = MORPH_SAMPLES_DIR;
+  struct Sample {
+    const char* file;
+    const char* spec;  // the structuring element the file was written from
+  };
+  const Sample generated[] = {
+      {"cube.off", "cube:1"},
+      {"hedra.off", "octahedron:1"},
+      {"tetrahedron.off", "tetrahedron:1"},
+      {"dodecahedron.off", "dodecahedron:1"},
+      {"icosphere_80.off", "sphere:1,1"},
+      {"icosphere_320.off", "sphere:1"},
+      {"icosphere_1280.off", "sphere:1,3"},
+      {"icosphere_5120.off", "sphere:r=1,level=4"},
+      {"uvsphere_1600.off", "uvsphere:1"},
+      {"snub_dodecahedron.off", "snub_dodecahedron:1"},
+      {"cylinder_16.off", "cylinder:r=0.5,h=1"},
+  };
+  for (const auto& sample : generated) {
+    const std::string file = sample.file;
+    CAPTURE(file);
+    const Mesh m = morph::read_mesh(directory / sample.file);
+    const Mesh expected = morph::make_structuring_element(sample.spec);
+    REQUIRE(m.n_vertices() == expected.n_vertices());
+    CHECK(m.n_faces() == expected.n_faces());
+    bool identical = true;
+    for (auto v : m.vertices())
+      identical = identical && m.point(v) == expected.point(Mesh::VertexHandle(v.idx()));
+    CHECK(identical);  // 17 digits: every coordinate round-trips exactly
+    check_convex(m);
+  }
+
+  // Hulls: truncated octahedron (8 hexagons + 6 squares, volume 4) and a random hull.
+  const Mesh truncated = morph::read_mesh(directory / "truncated_octahedron.off");
+  check_counts(truncated, 24, 36, {{4, 6}, {6, 8}});
+  CHECK(morph::signed_volume(truncated) == doctest::Approx(4.0).epsilon(1e-15));
+  check_convex(truncated);
+  const Mesh random = morph::read_mesh(directory / "random_hull_200.off");
+  CHECK(random.n_vertices() - random.n_edges() + random.n_faces() == 2);
+  CHECK(morph::signed_volume(random) < 4.0 / 3.0 * M_PI);  // inside the unit ball
+  for (auto v : random.vertices()) CHECK(random.point(v).norm() <= 1.0);
+  check_convex(random);
+}

@@ -143,8 +143,12 @@ std::vector<std::vector<int>> hull_polygons(const std::vector<Point>& points) {
       h = out.at(static_cast<int>(hull.target(h)));
       if (h == out.begin()->second) break;
     }
+    // CGAL may shuffle its input: put each loop's smallest index first and sort the
+    // loops, so that the faces (and the icosphere built on them) are reproducible.
+    std::rotate(polygon.begin(), std::min_element(polygon.begin(), polygon.end()), polygon.end());
     polygons.push_back(std::move(polygon));
   }
+  std::sort(polygons.begin(), polygons.end());
   return polygons;
 }
 
