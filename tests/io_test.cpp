@@ -397,6 +397,7 @@ TEST_CASE("io: binary STL round trip is exact for float values and rounds double
   morph::WriteOptions options;
   options.binary = true;
   CHECK_THROWS_AS(morph::write_mesh(huge, out, MeshFormat::stl, options), morph::input_error);
+  CHECK(out.str().empty());  // checked before anything is written
 }
 
 TEST_CASE("io: round trip through files for every format and variant") {
@@ -448,6 +449,35 @@ TEST_CASE("io: polygons stay polygons, large valences too") {
   Mesh fan = round_trip(disk, MeshFormat::stl, true);
   CHECK(fan.n_faces() == 298);
   CHECK(fan.n_vertices() == 300);
+}
+
+TEST_CASE("io: STL facets carry the polygon's unit normal") {
+  std::stringstream ascii;
+  morph::write_mesh(make_cube(), ascii, MeshFormat::stl);
+  const std::string text = ascii.str();
+  std::vector<std::string> normals;
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.find("facet normal") != std::string::npos) normals.push_back(line);
+  }
+  // Two fan triangles per quad, in face order: -z, +z, -y, +y, -x, +x.
+  const std::vector<std::string> expected = {"0 0 -1", "0 0 1",  "0 -1 0",
+                                             "0 1 0",  "-1 0 0", "1 0 0"};
+  REQUIRE(normals.size() == 12);
+  for (std::size_t i = 0; i < 12; ++i) {
+    CHECK(normals[i] == "  facet normal " + expected[i / 2]);
+  }
+  morph::WriteOptions options;
+  options.binary = true;
+  std::stringstream binary;
+  morph::write_mesh(make_cube(), binary, MeshFormat::stl, options);
+  const std::string bytes = binary.str();
+  REQUIRE(bytes.size() == 84 + 12 * 50);
+  float n[3];
+  std::memcpy(n, bytes.data() + 84 + 50 * 11, sizeof n);  // last triangle: +x face
+  CHECK(n[0] == 1.0f);
+  CHECK(n[1] == 0.0f);
+  CHECK(n[2] == 0.0f);
 }
 
 TEST_CASE("io: STL corners are merged into shared vertices") {

@@ -205,13 +205,18 @@ Point polygon_normal(const Mesh& mesh, Mesh::FaceHandle f) {
   return normal / length;
 }
 
-// `value` as a float32 for binary STL; throws if it is beyond float's range.
-float to_float(double value, int vertex) {
-  if (std::fabs(value) > static_cast<double>(std::numeric_limits<float>::max())) {
-    throw input_error("write_mesh: vertex " + std::to_string(vertex) +
-                      ": a coordinate is beyond the range of binary STL's 32-bit floats");
+// Throws unless every written coordinate fits in binary STL's float32 (checked before
+// anything is written, so a stream gets no partial file).
+void check_float_range(const WriteView& view, const Mesh& mesh) {
+  for (std::size_t i = 0; i < view.vertices.size(); ++i) {
+    const Point& p = mesh.point(view.vertices[i]);
+    for (int k = 0; k < 3; ++k) {
+      if (std::fabs(p[k]) > static_cast<double>(std::numeric_limits<float>::max())) {
+        throw input_error("write_mesh: vertex " + std::to_string(i) +
+                          ": a coordinate is beyond the range of binary STL's 32-bit floats");
+      }
+    }
   }
-  return static_cast<float>(value);
 }
 
 }  // namespace
@@ -236,6 +241,7 @@ void write_stl(const WriteView& view, const Mesh& mesh, std::ostream& out, bool 
   BlockWriter writer(out);
   std::string& text = writer.buffer();
   if (binary) {
+    check_float_range(view, mesh);
     std::uint64_t triangles = 0;
     for (Mesh::FaceHandle f : view.faces) triangles += mesh.valence(f) - 2;
     if (triangles > std::numeric_limits<std::uint32_t>::max()) {
@@ -260,8 +266,7 @@ void write_stl(const WriteView& view, const Mesh& mesh, std::ostream& out, bool 
         for (int k = 0; k < 3; ++k) append_le<float>(text, static_cast<float>(normal[k]));
         for (Mesh::VertexHandle v : triangle) {
           const Point& p = mesh.point(v);
-          for (int k = 0; k < 3; ++k)
-            append_le<float>(text, to_float(p[k], view.index_of[v.idx()]));
+          for (int k = 0; k < 3; ++k) append_le<float>(text, static_cast<float>(p[k]));
         }
         append_le<std::uint16_t>(text, 0);
       } else {
