@@ -104,9 +104,13 @@ JobResult run_job(const Job& job, const JobSettings& settings, Reporter& reporte
   const std::string output_name = job.output == kStdStream ? "<stdout>" : job.output;
 
   Stage stage = Stage::usage;
-  std::string about = output_name;
+  std::string about = name;
   try {
-    // The output's format is checked first: a bad extension fails before any work.
+    // Formats are checked first: a missing --format or a bad extension fails before any work.
+    if (job.input == kStdStream && !settings.stdin_format) {
+      throw input_error("reading stdin needs --input-format (or --format) off|obj|ply|stl");
+    }
+    about = output_name;
     std::optional<MeshFormat> output_format;
     if (!job.output.empty()) output_format = output_format_for(job.output, settings.output_format);
 
@@ -151,7 +155,9 @@ JobResult run_job(const Job& job, const JobSettings& settings, Reporter& reporte
       }
       current = std::move(step_result.mesh);
       origins = std::move(step_result.origins);
-      has_origins = op_is_dilation_based(step.step.op);
+      // Dilation and opening label every facet; closing ends with an erosion and
+      // erosion's facets carry no origin (MorphResult::origins is then empty).
+      has_origins = !origins.empty();
       if (has_origins && origins.size() != current.n_faces()) {
         throw std::logic_error("'" + label + "' returned " + std::to_string(origins.size()) + " facet origins for " +
                                std::to_string(current.n_faces()) + " facets");
@@ -201,8 +207,8 @@ JobResult run_job(const Job& job, const JobSettings& settings, Reporter& reporte
         } else if (!stats.empty) {
           std::call_once(g_warned_labels_erosion, [&] {
             reporter.warning(output_name,
-                             "--label-facets: a result whose last step is an erosion (or with no step) has no "
-                             "facet origins; no colours written");
+                             "--label-facets: the result of an erosion or a closing (or of no operation) has "
+                             "no facet origins; no colours written");
           });
         }
       }

@@ -80,7 +80,7 @@ std::string label_palette_help() {
          "  translated  0 114 178   blue    a facet of the input moved by a vertex of the element\n"
          "  corner      230 159 0   orange  a facet of the element placed at a vertex of the input\n"
          "  edge        0 158 115   green   a parallelogram: an input edge (+) an element edge\n"
-         "  (erosion results carry no origins and are written without colours)\n";
+         "  (results of erode and close end with an erosion: no origins, written without colours)\n";
 }
 
 namespace {

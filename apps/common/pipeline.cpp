@@ -57,8 +57,6 @@ std::optional<Op> op_from_name(std::string_view name) {
   return std::nullopt;
 }
 
-bool op_is_dilation_based(Op op) { return op != Op::erode; }
-
 PipelineStep parse_step(std::string_view text, std::string_view where) {
   const std::string_view step = trim(text);
   std::size_t end = 0;

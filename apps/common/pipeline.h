@@ -30,9 +30,6 @@ const char* op_name(Op op);
 /// The op named by a word; nullopt for any other word.
 std::optional<Op> op_from_name(std::string_view name);
 
-/// True for the ops whose result carries facet origins (dilate, open, close).
-bool op_is_dilation_based(Op op);
-
 /// One step of a pipeline.
 struct PipelineStep {
   Op op = Op::dilate;
