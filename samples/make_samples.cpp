@@ -2,15 +2,14 @@
 //   make-samples <output directory>
 // Every mesh is checked with check_convex_polyhedron before it is written, and written
 // with 17 significant digits (write_mesh), so the files are exact copies of the doubles.
-#include <morph/error.h>
-#include <morph/io.h>
-#include <morph/structuring_element.h>
-#include <morph/validate.h>
-
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/boost/graph/Euler_operations.h>
 #include <CGAL/convex_hull_3.h>
+#include <morph/error.h>
+#include <morph/io.h>
+#include <morph/structuring_element.h>
+#include <morph/validate.h>
 
 #include <algorithm>
 #include <array>
@@ -51,7 +50,8 @@ morph::Mesh convex_hull(const std::vector<morph::Point>& points) {
   // sorted), since CGAL may shuffle its input: the files are then reproducible.
   std::map<std::array<double, 3>, int> input_index;
   for (std::size_t i = 0; i < points.size(); ++i)
-    input_index.emplace(std::array<double, 3>{points[i][0], points[i][1], points[i][2]}, static_cast<int>(i));
+    input_index.emplace(std::array<double, 3>{points[i][0], points[i][1], points[i][2]},
+                        static_cast<int>(i));
   std::map<int, int> used;  // input index -> mesh index
   std::vector<std::vector<int>> faces;
   for (auto f : hull.faces()) {
@@ -131,13 +131,14 @@ int main(int argc, char** argv) {
     for (const auto& [name, mesh] : samples) {
       const auto check = morph::check_convex_polyhedron(mesh);
       if (!check.ok()) {
-        std::cerr << "make-samples: " << name << " is not a convex polyhedron: " << check.problem << '\n';
+        std::cerr << "make-samples: " << name << " is not a convex polyhedron: " << check.problem
+                  << '\n';
         return 1;
       }
       morph::write_mesh(mesh, directory / name);
       std::cout << name << ": " << mesh.n_vertices() << " vertices, " << mesh.n_edges()
-                << " edges, " << mesh.n_faces() << " faces, volume "
-                << morph::signed_volume(mesh) << '\n';
+                << " edges, " << mesh.n_faces() << " faces, volume " << morph::signed_volume(mesh)
+                << '\n';
     }
   } catch (const std::exception& error) {
     std::cerr << "make-samples: " << error.what() << '\n';

@@ -2,7 +2,6 @@
 // (20*4^L triangles, Euler's formula), circumradii, uniform edge lengths, and volumes
 // of the solids from their textbook formulas.
 #include <doctest/doctest.h>
-
 #include <morph/error.h>
 #include <morph/io.h>
 #include <morph/structuring_element.h>
@@ -41,7 +40,8 @@ void check_counts(const Mesh& mesh, std::size_t vertices, std::size_t edges,
 // Largest relative deviation of a vertex's distance to the origin from `radius`.
 double radius_error(const Mesh& mesh, double radius) {
   double worst = 0;
-  for (auto v : mesh.vertices()) worst = std::max(worst, std::abs(mesh.point(v).norm() / radius - 1));
+  for (auto v : mesh.vertices())
+    worst = std::max(worst, std::abs(mesh.point(v).norm() / radius - 1));
   return worst;
 }
 
@@ -122,7 +122,8 @@ TEST_CASE("se: box and cube are exact: corners at half edges, volume x*y*z") {
   exact.planarity_tolerance = 0;  // exactly planar faces and edges
   const auto result = morph::check_convex_polyhedron(box, exact);
   CHECK_MESSAGE(result.ok(), result.problem);
-  CHECK(morph::signed_volume(morph::make_box(0.2, 0.2, 0.2)) == doctest::Approx(0.008).epsilon(1e-14));
+  CHECK(morph::signed_volume(morph::make_box(0.2, 0.2, 0.2)) ==
+        doctest::Approx(0.008).epsilon(1e-14));
 }
 
 TEST_CASE("se: platonic solids by circumradius: counts, radius, edges, volume") {
@@ -139,7 +140,8 @@ TEST_CASE("se: platonic solids by circumradius: counts, radius, edges, volume") 
   const Solid solids[] = {
       {"tetrahedron", morph::make_tetrahedron(r), 4, 6, 4, 3, r * std::sqrt(8.0 / 3.0),
        1 / (6 * std::sqrt(2.0))},
-      {"octahedron", morph::make_octahedron(r), 6, 12, 8, 3, r * std::sqrt(2.0), std::sqrt(2.0) / 3},
+      {"octahedron", morph::make_octahedron(r), 6, 12, 8, 3, r * std::sqrt(2.0),
+       std::sqrt(2.0) / 3},
       {"icosahedron", morph::make_icosahedron(r), 12, 30, 20, 3, r / std::sin(2 * M_PI / 5),
        5.0 / 12.0 * (3 + sqrt5)},
       {"dodecahedron", morph::make_dodecahedron(r), 20, 30, 12, 5,
@@ -178,7 +180,9 @@ TEST_CASE("se: cylinder is an n-gon prism with exact height and prism volume") {
   }
 }
 
-TEST_CASE("se: snub dodecahedron: 60 vertices of degree 5, 80 triangles + 12 pentagons, one edge length") {
+TEST_CASE(
+    "se: snub dodecahedron: 60 vertices of degree 5, 80 triangles + 12 pentagons, one edge "
+    "length") {
   const Mesh m = morph::make_snub_dodecahedron(1.0);
   check_counts(m, 60, 150, {{3, 80}, {5, 12}});
   for (auto v : m.vertices()) CHECK(v.valence() == 5);
@@ -194,9 +198,9 @@ TEST_CASE("se: snub dodecahedron: 60 vertices of degree 5, 80 triangles + 12 pen
 
 TEST_CASE("se: every generator is centred on the origin and outward") {
   const std::vector<Mesh> meshes = {
-      morph::make_icosphere(1, 2),   morph::make_uv_sphere(1, 12), morph::make_box(1, 2, 3),
-      morph::make_tetrahedron(1),    morph::make_octahedron(1),    morph::make_icosahedron(1),
-      morph::make_dodecahedron(1),   morph::make_cylinder(1, 1, 7), morph::make_snub_dodecahedron(1)};
+      morph::make_icosphere(1, 2), morph::make_uv_sphere(1, 12),  morph::make_box(1, 2, 3),
+      morph::make_tetrahedron(1),  morph::make_octahedron(1),     morph::make_icosahedron(1),
+      morph::make_dodecahedron(1), morph::make_cylinder(1, 1, 7), morph::make_snub_dodecahedron(1)};
   for (const auto& m : meshes) {
     morph::Point sum(0, 0, 0);
     for (auto v : m.vertices()) sum += m.point(v);
@@ -207,7 +211,9 @@ TEST_CASE("se: every generator is centred on the origin and outward") {
 }
 
 TEST_CASE("se: spec forms, positional and named, with defaults") {
-  const auto faces = [](const char* spec) { return morph::make_structuring_element(spec).n_faces(); };
+  const auto faces = [](const char* spec) {
+    return morph::make_structuring_element(spec).n_faces();
+  };
   const auto volume = [](const char* spec) {
     return morph::signed_volume(morph::make_structuring_element(spec));
   };
@@ -236,18 +242,50 @@ TEST_CASE("se: spec forms, positional and named, with defaults") {
   CHECK(faces("cylinder:r=1,h=2") == 18);  // default n = 16
   CHECK(faces("cylinder:1,2,8") == 10);
   CHECK(faces("cylinder:h=2,r=1,n=5") == 7);
-  CHECK(volume("cylinder:1,2,4") == doctest::Approx(4.0).epsilon(1e-14));  // square of area 2, height 2
+  CHECK(volume("cylinder:1,2,4") ==
+        doctest::Approx(4.0).epsilon(1e-14));  // square of area 2, height 2
 }
 
 TEST_CASE("se: every bad spec is an input_error listing the valid forms") {
-  for (const char* spec :
-       {"", "   ", "sphere", "sphere:", "sphere:r=", "sphere:r=-1", "sphere:0", "sphere:r=nan",
-        "sphere:r=inf", "sphere:1e400", "sphere:1,level=8", "sphere:1,level=-1", "sphere:1,2.5",
-        "sphere:r=1,r=2", "sphere:level=2", "sphere:1,2,3", "sphere:q=1", "sphere:r=1,",
-        "sphere:r=1,2", "sphere:,1", "cube", "cube:abc", "cube:1x", "cube:0x10", "box:1,2",
-        "box:1,2,3,4", "box:x=1,y=2", "uvsphere:1,n=2", "uvsphere:1,n=5000", "uvsphere:1,n=1e9",
-        "cylinder:1,1,2", "cylinder:r=1,n=8", "cylinder:1,-1", "tetrahedron:", "octahedron:1,2",
-        "dodecahedron:r=1e-200", "torus:1,0.5", "sphere=1", "icosahedron:r=1e300"})
+  for (const char* spec : {"",
+                           "   ",
+                           "sphere",
+                           "sphere:",
+                           "sphere:r=",
+                           "sphere:r=-1",
+                           "sphere:0",
+                           "sphere:r=nan",
+                           "sphere:r=inf",
+                           "sphere:1e400",
+                           "sphere:1,level=8",
+                           "sphere:1,level=-1",
+                           "sphere:1,2.5",
+                           "sphere:r=1,r=2",
+                           "sphere:level=2",
+                           "sphere:1,2,3",
+                           "sphere:q=1",
+                           "sphere:r=1,",
+                           "sphere:r=1,2",
+                           "sphere:,1",
+                           "cube",
+                           "cube:abc",
+                           "cube:1x",
+                           "cube:0x10",
+                           "box:1,2",
+                           "box:1,2,3,4",
+                           "box:x=1,y=2",
+                           "uvsphere:1,n=2",
+                           "uvsphere:1,n=5000",
+                           "uvsphere:1,n=1e9",
+                           "cylinder:1,1,2",
+                           "cylinder:r=1,n=8",
+                           "cylinder:1,-1",
+                           "tetrahedron:",
+                           "octahedron:1,2",
+                           "dodecahedron:r=1e-200",
+                           "torus:1,0.5",
+                           "sphere=1",
+                           "icosahedron:r=1e300"})
     check_bad_spec(spec);
 }
 

@@ -1,7 +1,6 @@
 // Verdicts of the operand checks on meshes built here, each good or broken in one known
 // way: the expected verdict comes from the construction, not from an earlier run.
 #include <doctest/doctest.h>
-
 #include <morph/error.h>
 #include <morph/structuring_element.h>
 #include <morph/validate.h>
@@ -226,8 +225,8 @@ TEST_CASE("validate: a polyhedral torus has genus 1") {
   std::vector<std::vector<int>> faces;
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j)
-      faces.push_back({4 * i + j, 4 * ((i + 1) % 4) + j, 4 * ((i + 1) % 4) + (j + 1) % 4,
-                       4 * i + (j + 1) % 4});
+      faces.push_back(
+          {4 * i + j, 4 * ((i + 1) % 4) + j, 4 * ((i + 1) % 4) + (j + 1) % 4, 4 * i + (j + 1) % 4});
   int added = 0;
   const Mesh torus = mesh_of(points, faces, &added);
   REQUIRE(added == 16);
@@ -240,7 +239,7 @@ TEST_CASE("validate: a polyhedral torus has genus 1") {
 TEST_CASE("validate: two tetrahedra sharing only a vertex are rejected") {
   // OpenMesh cannot close a second fan around vertex 0 (add_face fails), so the pinched
   // mesh is left with a hole; the check reports it.
-  const std::vector<Point> points = {{0, 0, 0},  {1, 0, 0},  {0, 1, 0},  {0, 0, 1},
+  const std::vector<Point> points = {{0, 0, 0},  {1, 0, 0},  {0, 1, 0}, {0, 0, 1},
                                      {-1, 0, 0}, {0, -1, 0}, {0, 0, -1}};
   const std::vector<std::vector<int>> faces = {{0, 2, 1}, {0, 4, 5}, {0, 1, 3}, {0, 6, 4},
                                                {0, 3, 2}, {0, 5, 6}, {1, 2, 3}, {4, 6, 5}};
@@ -271,8 +270,8 @@ TEST_CASE("validate: empty mesh and isolated vertex") {
 }
 
 TEST_CASE("validate: a flat double-sided square encloses no volume") {
-  const Mesh pillow = mesh_of({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}},
-                              {{0, 1, 2, 3}, {3, 2, 1, 0}});
+  const Mesh pillow =
+      mesh_of({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, {{0, 1, 2, 3}, {3, 2, 1, 0}});
   REQUIRE(morph::check_closed_manifold(pillow).ok());
   const auto result = morph::check_outward_oriented(pillow);
   REQUIRE_FALSE(result.ok());

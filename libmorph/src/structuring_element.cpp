@@ -5,14 +5,13 @@
 // subdivision) are built face by face. Solids given by their vertices (the platonic
 // solids, the snub dodecahedron) take their faces from the convex hull of the vertices,
 // with the hull's coplanar triangles merged back into polygons.
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/convex_hull_3.h>
 #include <morph/error.h>
 #include <morph/io.h>
 #include <morph/structuring_element.h>
 #include <morph/validate.h>
-
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Surface_mesh.h>
-#include <CGAL/convex_hull_3.h>
 
 #include <algorithm>
 #include <array>
@@ -32,10 +31,10 @@ namespace morph {
 namespace {
 
 // Limits on the parameters: beyond them a spec is a mistake, not a structuring element.
-constexpr int kMaxIcosphereLevel = 7;    // 327,680 triangles
-constexpr int kMinSides = 3;             // fewest sides of a polygon
-constexpr int kMaxSides = 4096;          // n of uvsphere and cylinder
-constexpr double kMinExtent = 1e-100;    // radii, edges: cubes of these stay finite in double
+constexpr int kMaxIcosphereLevel = 7;  // 327,680 triangles
+constexpr int kMinSides = 3;           // fewest sides of a polygon
+constexpr int kMaxSides = 4096;        // n of uvsphere and cylinder
+constexpr double kMinExtent = 1e-100;  // radii, edges: cubes of these stay finite in double
 constexpr double kMaxExtent = 1e100;
 
 // Two hull triangles are one face when each lies within this fraction of the
@@ -49,7 +48,8 @@ using HullMesh = CGAL::Surface_mesh<Kernel::Point_3>;
 
 void require_extent(double value, const char* what) {
   if (!(std::isfinite(value) && value >= kMinExtent && value <= kMaxExtent))
-    throw input_error(std::string(what) + " must be a positive finite number between 1e-100 and 1e100, got " +
+    throw input_error(std::string(what) +
+                      " must be a positive finite number between 1e-100 and 1e100, got " +
                       std::to_string(value));
 }
 
@@ -94,7 +94,8 @@ std::vector<std::vector<int>> hull_polygons(const std::vector<Point>& points) {
   // Hull vertices back to input indices (the hull copies the points exactly).
   std::map<std::array<double, 3>, int> index;
   for (std::size_t i = 0; i < points.size(); ++i)
-    index.emplace(std::array<double, 3>{points[i][0], points[i][1], points[i][2]}, static_cast<int>(i));
+    index.emplace(std::array<double, 3>{points[i][0], points[i][1], points[i][2]},
+                  static_cast<int>(i));
   const auto id = [&](HullMesh::Vertex_index v) {
     const auto& p = hull.point(v);
     return index.at({p.x(), p.y(), p.z()});
@@ -124,7 +125,8 @@ std::vector<std::vector<int>> hull_polygons(const std::vector<Point>& points) {
   for (auto e : hull.edges()) {
     const auto h = hull.halfedge(e);
     if (far_corner_height(h) <= tolerance && far_corner_height(hull.opposite(h)) <= tolerance)
-      group[find(static_cast<int>(hull.face(h)))] = find(static_cast<int>(hull.face(hull.opposite(h))));
+      group[find(static_cast<int>(hull.face(h)))] =
+          find(static_cast<int>(hull.face(hull.opposite(h))));
   }
 
   // Each group's boundary, walked along its halfedges (outward, as the hull's).
@@ -241,7 +243,8 @@ std::vector<double> parse_arguments(std::string_view spec, std::string_view argu
     }
     if (text.empty() || result.ec != std::errc() || result.ptr != end)
       bad_spec(spec, std::string("\"") + parameters[slot].name + "\" is not " +
-                         (parameters[slot].integer ? "an integer" : "a number") + ": \"" + text + "\"");
+                         (parameters[slot].integer ? "an integer" : "a number") + ": \"" + text +
+                         "\"");
     values[slot] = value;
   }
   std::vector<double> out;
@@ -267,13 +270,15 @@ bool names_a_file(std::string_view spec) {
 
 std::string structuring_element_grammar() {
   return "  sphere:r=R[,level=L]     icosphere (geodesic, 20*4^L triangles), L in 0..7, default 2\n"
-         "  uvsphere:r=R[,n=N]       UV sphere, N longitudes x N latitudes, N in 3..4096, default 40\n"
+         "  uvsphere:r=R[,n=N]       UV sphere, N longitudes x N latitudes, N in 3..4096, default "
+         "40\n"
          "  cube:S                   axis-aligned cube of edge S\n"
          "  box:X,Y,Z                axis-aligned box of edges X, Y, Z\n"
          "  tetrahedron:R  octahedron:R  icosahedron:R  dodecahedron:R\n"
          "                           platonic solids of circumradius R\n"
          "  snub_dodecahedron:R      snub dodecahedron of circumradius R\n"
-         "  cylinder:r=R,h=H[,n=N]   prism with an N-gon cross-section (N in 3..4096, default 16), axis z\n"
+         "  cylinder:r=R,h=H[,n=N]   prism with an N-gon cross-section (N in 3..4096, default 16), "
+         "axis z\n"
          "  a path to a mesh file    any convex mesh (.off .obj .ply .stl), used as it is\n"
          "Positional values may also be named (cube:s=0.2, box:x=1,y=2,z=3); lengths are\n"
          "positive finite numbers.\n";
@@ -323,16 +328,17 @@ Mesh make_structuring_element(std::string_view spec) {
   }
   using Maker = Mesh (*)(double);
   static const std::vector<std::pair<std::string, Maker>> by_radius = {
-      {"tetrahedron", make_tetrahedron},   {"octahedron", make_octahedron},
-      {"icosahedron", make_icosahedron},   {"dodecahedron", make_dodecahedron},
+      {"tetrahedron", make_tetrahedron},
+      {"octahedron", make_octahedron},
+      {"icosahedron", make_icosahedron},
+      {"dodecahedron", make_dodecahedron},
       {"snub_dodecahedron", make_snub_dodecahedron}};
   for (const auto& [name, make] : by_radius) {
     if (kind != name) continue;
     const auto v = values({{"r", {}}});
     return build([&] { return make(v[0]); });
   }
-  if (colon == std::string::npos)
-    bad_spec(spec, "not a known solid, and no such file");
+  if (colon == std::string::npos) bad_spec(spec, "not a known solid, and no such file");
   bad_spec(spec, "unknown solid \"" + kind + "\"");
 }
 
@@ -399,7 +405,8 @@ Mesh make_uv_sphere(double radius, int n) {
   std::vector<std::vector<int>> faces;
   for (int j = 0; j < n; ++j) {
     faces.push_back({0, at(1, j), at(1, j + 1)});
-    for (int i = 1; i + 1 < n; ++i) faces.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
+    for (int i = 1; i + 1 < n; ++i)
+      faces.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
     faces.push_back({south, at(n - 1, j + 1), at(n - 1, j)});
   }
   return mesh_from_polygons(points, faces);
@@ -411,7 +418,8 @@ Mesh make_box(double x, double y, double z) {
   require_extent(z, "box edge z");
   std::vector<Point> points;
   for (int i = 0; i < 8; ++i)
-    points.emplace_back((i & 1 ? 0.5 : -0.5) * x, (i & 2 ? 0.5 : -0.5) * y, (i & 4 ? 0.5 : -0.5) * z);
+    points.emplace_back((i & 1 ? 0.5 : -0.5) * x, (i & 2 ? 0.5 : -0.5) * y,
+                        (i & 4 ? 0.5 : -0.5) * z);
   // Each face: the corners with one coordinate bit fixed, in cyclic order.
   const std::vector<std::vector<int>> faces = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
                                                {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
@@ -425,8 +433,12 @@ Mesh make_tetrahedron(double radius) {
 
 Mesh make_octahedron(double radius) {
   require_extent(radius, "octahedron circumradius");
-  return hull_mesh({{radius, 0, 0}, {-radius, 0, 0}, {0, radius, 0},
-                    {0, -radius, 0}, {0, 0, radius}, {0, 0, -radius}});
+  return hull_mesh({{radius, 0, 0},
+                    {-radius, 0, 0},
+                    {0, radius, 0},
+                    {0, -radius, 0},
+                    {0, 0, radius},
+                    {0, 0, -radius}});
 }
 
 Mesh make_icosahedron(double radius) {
@@ -490,7 +502,8 @@ Mesh make_snub_dodecahedron(double radius) {
   std::vector<Point> points;
   for (const auto& t : base)
     for (int shift = 0; shift < 3; ++shift)
-      for (const auto& signs : {std::array<double, 3>{-1, -1, -1}, {1, 1, -1}, {1, -1, 1}, {-1, 1, 1}})
+      for (const auto& signs :
+           {std::array<double, 3>{-1, -1, -1}, {1, 1, -1}, {1, -1, 1}, {-1, 1, 1}})
         points.emplace_back(signs[0] * t[shift % 3], signs[1] * t[(shift + 1) % 3],
                             signs[2] * t[(shift + 2) % 3]);
   return hull_mesh(scaled_to_radius(std::move(points), radius));

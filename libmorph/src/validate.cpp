@@ -148,7 +148,8 @@ Finding closed_manifold(const Mesh& mesh) {
                 "the mesh has genus " + std::to_string((2 - euler) / 2) +
                     " (Euler characteristic V - E + F = " + std::to_string(n_vertices) + " - " +
                     std::to_string(n_edges) + " + " + std::to_string(n_faces) + " = " +
-                    std::to_string(euler) + "), not 0: a convex polyhedron is a topological sphere");
+                    std::to_string(euler) +
+                    "), not 0: a convex polyhedron is a topological sphere");
   return {};
 }
 
@@ -250,10 +251,10 @@ Finding planar_and_convex(const Mesh& mesh, double relative_tolerance) {
     for (auto v : mesh.fv_range(f)) {
       const double distance = std::abs(OpenMesh::dot(mesh.point(v) - plane.centroid, plane.normal));
       if (!(distance <= tolerance))
-        return fail(Verdict::not_convex, "face " + std::to_string(f.idx()) +
-                                             " is not planar: vertex " + std::to_string(v.idx()) +
-                                             " is " + number(distance) + " from its plane (tolerance " +
-                                             number(tolerance) + ")");
+        return fail(Verdict::not_convex,
+                    "face " + std::to_string(f.idx()) + " is not planar: vertex " +
+                        std::to_string(v.idx()) + " is " + number(distance) +
+                        " from its plane (tolerance " + number(tolerance) + ")");
     }
     planes[f.idx()] = plane;
   }
