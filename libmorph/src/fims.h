@@ -37,9 +37,18 @@ LabelledMesh sum_mesh(const Polytope& A, const Polytope& B, const SumFacets& fac
 /// The exact result as a polytope (exact vertex sums), for chaining operations.
 Polytope sum_polytope(const Polytope& A, const Polytope& B, const SumFacets& facets);
 
-/// Builds a mesh from rounded points and facet cycles, merging points that round to the
-/// same place and dropping facets that degenerate; `keep` (optional, one per facet)
-/// receives whether each facet survived.
+/// Features of an exact result smaller than this fraction of its bounding-box diagonal
+/// are below what doubles (and the validation tolerance, kPlanarityTolerance = 1e-9)
+/// can represent faithfully: they come from rounding noise in the input, e.g. planes
+/// that meet almost, but not exactly, in one point. Edges shorter than this are
+/// collapsed in the output. Chosen well below any visible feature and well above the
+/// noise of floating-point input (about 1e-15 relative).
+inline constexpr double kFeatureTolerance = 1e-11;
+
+/// Builds a mesh from rounded points and facet cycles, collapsing edges shorter than
+/// kFeatureTolerance times the diagonal (each cluster keeps its lowest-index vertex) and
+/// dropping facets that degenerate; `keep` (optional, one per facet) receives whether
+/// each facet survived.
 Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& face_begin,
                 const std::vector<int>& corners, std::vector<char>* keep);
 

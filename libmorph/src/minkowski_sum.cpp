@@ -9,6 +9,7 @@
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
 #include "gauss_map.h"
@@ -234,27 +235,42 @@ Polytope sum_polytope(const Polytope& A, const Polytope& B, const SumFacets& fac
 Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& face_begin,
                 const std::vector<int>& corners, std::vector<char>* keep) {
   const int n = static_cast<int>(points.size());
-  // Representatives of points that round to the same place.
-  std::vector<int> order(n);
-  std::iota(order.begin(), order.end(), 0);
-  auto less = [&](int a, int b) {
-    const auto& p = points[a];
-    const auto& q = points[b];
-    return std::tie(p.x, p.y, p.z) < std::tie(q.x, q.y, q.z);
-  };
-  tbb::parallel_sort(order.begin(), order.end(), less);
+  const int nf = static_cast<int>(face_begin.size()) - 1;
+  // Edges shorter than kFeatureTolerance times the diagonal are collapsed; each cluster
+  // keeps the position of its lowest-index vertex (an exact result vertex, rounded).
+  V3<double> lo{0, 0, 0}, hi{0, 0, 0};
+  if (n > 0) lo = hi = points[0];
+  for (const auto& p : points) {
+    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+  }
+  const V3<double> span = hi - lo;
+  const double limit = kFeatureTolerance * std::sqrt(dot(span, span));
   std::vector<int> rep(n);
-  for (int k = 0; k < n; ++k) rep[order[k]] = (k > 0 && !less(order[k - 1], order[k])) ? rep[order[k - 1]] : order[k];
+  std::iota(rep.begin(), rep.end(), 0);
+  auto find = [&](int x) {
+    while (rep[x] != x) x = rep[x] = rep[rep[x]];
+    return x;
+  };
+  for (int f = 0; f < nf; ++f) {
+    for (int c = face_begin[f]; c < face_begin[f + 1]; ++c) {
+      const int u = corners[c], w = corners[c + 1 == face_begin[f + 1] ? face_begin[f] : c + 1];
+      const V3<double> d = points[u] - points[w];
+      if (std::sqrt(dot(d, d)) <= limit) {
+        const int a = find(u), b = find(w);
+        if (a != b) rep[std::max(a, b)] = std::min(a, b);
+      }
+    }
+  }
   Mesh mesh;
   std::vector<Mesh::VertexHandle> handle(n);
-  std::vector<int> used(n, 0);
-  const int nf = static_cast<int>(face_begin.size()) - 1;
+  std::vector<char> used(n, 0);
   std::vector<std::vector<int>> faces(nf);
   if (keep) keep->assign(nf, 0);
   for (int f = 0; f < nf; ++f) {
     auto& cyc = faces[f];
     for (int c = face_begin[f]; c < face_begin[f + 1]; ++c) {
-      const int v = rep[corners[c]];
+      const int v = find(corners[c]);
       if (cyc.empty() || cyc.back() != v) cyc.push_back(v);
     }
     while (cyc.size() > 1 && cyc.front() == cyc.back()) cyc.pop_back();
@@ -273,7 +289,8 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
     for (int v : faces[f]) fh.push_back(handle[v]);
     if (!mesh.add_face(fh).is_valid())
       throw error("internal error: facet " + std::to_string(f) +
-                  " of the result could not be joined to its neighbours (features below double precision)");
+                  " of the result could not be joined to its neighbours after merging features below "
+                  "double precision");
     if (keep) (*keep)[f] = 1;
   }
   return mesh;
