@@ -208,7 +208,7 @@ int run(int argc, const char* const argv[], Reporter& reporter) {
     }
     const JobResult result = run_job(Job{files.front(), common.output}, settings, reporter);
     if (result.failure) report(reporter, *result.failure);
-    return result.exit_code;
+    return exit_code_after(result);
   }
 
   // Batch: check everything that concerns the whole batch before any work.

@@ -162,6 +162,10 @@ Failure classify_current_exception(Stage stage, std::string_view file, std::stri
     code = kExitSoftware;
     what = "internal error: unknown exception";
   }
+  if (stage == Stage::structuring_element && code == kExitUsage) {
+    // The library appends the whole grammar on further lines; --help shows it.
+    what = what.substr(0, what.find('\n'));
+  }
   Failure failure = make_failure(code, file, what, program);
   if (stage == Stage::structuring_element && code == kExitUsage) {
     failure.hint = "Run '" + std::string(program) + " --help' for the structuring-element grammar";

@@ -231,4 +231,8 @@ JobResult run_job(const Job& job, const JobSettings& settings, Reporter& reporte
   return result;
 }
 
+int exit_code_after(const JobResult& result) {
+  return interrupted() ? static_cast<int>(kExitInterrupted) : result.exit_code;
+}
+
 }  // namespace morph::cli

@@ -64,4 +64,8 @@ struct JobResult {
 /// code is 4.
 JobResult run_job(const Job& job, const JobSettings& settings, Reporter& reporter);
 
+/// The exit status of a single-file run: 130 when SIGINT came during the (completed,
+/// atomic) write, else the job's own.
+int exit_code_after(const JobResult& result);
+
 }  // namespace morph::cli

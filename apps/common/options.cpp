@@ -72,7 +72,9 @@ std::optional<Failure> apply_common_options(const CommonOptions& o, const Thread
 }
 
 std::string se_grammar_help() {
-  return "Structuring elements (--se SPEC), centred on the origin:\n" + structuring_element_grammar() + "\n";
+  std::string grammar = structuring_element_grammar();
+  while (!grammar.empty() && grammar.back() == '\n') grammar.pop_back();
+  return "Structuring elements (--se SPEC), centred on the origin:\n" + grammar + "\n";
 }
 
 std::string label_palette_help() {
@@ -121,7 +123,7 @@ std::string operation_usage(const std::string& program, Op op, const po::options
   std::ostringstream out;
   out << "Usage: " << program << " INPUT --se SPEC -o OUTPUT [options]\n\n"
       << help.summary << "\nINPUT is a mesh file (.off .obj .ply .stl) or '-' for stdin (with --input-format).\n"
-      << "It must be a closed convex polyhedron; an inverted one is flipped (a note with -v).\n\n"
+      << "It must be a closed convex polyhedron; an inverted one is flipped (a note with -v).\n"
       << visible << "\n"
       << se_grammar_help() << "\n"
       << label_palette_help() << "\n"
@@ -201,7 +203,7 @@ int run_operation_app(int argc, const char* const argv[], Op op) {
     }
     const JobResult result = run_job(Job{input, common.output}, settings, reporter);
     if (result.failure) report(reporter, *result.failure);
-    return result.exit_code;
+    return exit_code_after(result);
   } catch (...) {
     report(reporter, classify_current_exception(Stage::compute, "", program));
     return kExitSoftware;
