@@ -6,13 +6,17 @@
 
 #include <CGAL/Gmpq.h>
 #include <CGAL/Interval_nt.h>
+#include <CGAL/Mpzf.h>
 
 #include <array>
 
 namespace morph::detail {
 
 using Interval = CGAL::Interval_nt<false>;  // needs the rounding mode set upward (RoundingGuard)
-using Exact = CGAL::Gmpq;
+using Exact = CGAL::Gmpq;  // rationals: positions of erosion results, planes, the LP
+/// Exact dyadic floats, much faster than rationals (no gcd) for +, - and *: the facet
+/// normals and every predicate on them (polynomials in double coordinates).
+using ExactN = CGAL::Mpzf;
 
 /// Sets the FPU rounding mode upward for interval arithmetic, restores it at scope exit.
 /// Every thread that evaluates predicates holds one; plain double arithmetic that must
@@ -85,6 +89,8 @@ inline int filtered_sign(const F& f, const Args&... args) {
 
 inline V3<Interval> to_interval(const V3<double>& p) { return {Interval(p.x), Interval(p.y), Interval(p.z)}; }
 inline V3<Exact> to_exact(const V3<double>& p) { return {Exact(p.x), Exact(p.y), Exact(p.z)}; }
+inline V3<ExactN> to_exact_n(const V3<double>& p) { return {ExactN(p.x), ExactN(p.y), ExactN(p.z)}; }
+inline V3<Exact> to_rational(const V3<ExactN>& p) { return {Exact(p.x), Exact(p.y), Exact(p.z)}; }
 inline V3<Interval> to_interval(const V3<Exact>& p) {
   return {Interval(CGAL::to_interval(p.x)), Interval(CGAL::to_interval(p.y)),
           Interval(CGAL::to_interval(p.z))};

@@ -40,7 +40,7 @@ CentreResult exact_centre(const std::vector<HalfSpace>& hs) {
   using Program = CGAL::Quadratic_program<Exact>;
   Program lp(CGAL::SMALLER, false, 0, false, 0);
   for (int i = 0; i < static_cast<int>(hs.size()); ++i) {
-    const auto& n = hs[i].normal;
+    const V3<Exact> n = to_rational(hs[i].normal);
     lp.set_a(0, i, n.x);
     lp.set_a(1, i, n.y);
     lp.set_a(2, i, n.z);
@@ -64,9 +64,10 @@ bool strictly_inside(const std::vector<HalfSpace>& hs, const V3<Exact>& o) {
   parallel_chunks(static_cast<int>(hs.size()), 512, [&](int begin, int end) {
     RoundingGuard guard;
     for (int i = begin; i < end && inside; ++i) {
-      const V3<Interval> n = to_interval(hs[i].normal);
+      const V3<ExactN>& ne = hs[i].normal;
+      const V3<Interval> n{Interval(ne.x.to_interval()), Interval(ne.y.to_interval()), Interval(ne.z.to_interval())};
       int s = interval_sign(Interval(CGAL::to_interval(hs[i].offset)) - dot(n, oi));
-      if (s == 2) s = CGAL::sign(hs[i].offset - dot(hs[i].normal, o));
+      if (s == 2) s = CGAL::sign(hs[i].offset - dot(to_rational(ne), o));
       if (s <= 0) inside = false;
     }
   });
@@ -98,8 +99,9 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
   std::vector<Kernel::Point_3> points(n);
   std::map<Kernel::Point_3, int> index_of;
   for (int i = 0; i < n; ++i) {
-    const Exact den = hs[i].offset - dot(hs[i].normal, o);
-    dual[i] = {hs[i].normal.x / den, hs[i].normal.y / den, hs[i].normal.z / den};
+    const V3<Exact> nr = to_rational(hs[i].normal);
+    const Exact den = hs[i].offset - dot(nr, o);
+    dual[i] = {nr.x / den, nr.y / den, nr.z / den};
     points[i] = Kernel::Point_3(to_kernel(dual[i].x), to_kernel(dual[i].y), to_kernel(dual[i].z));
     index_of.emplace(points[i], i);
   }
@@ -166,13 +168,15 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
     const auto& cyc = faces[0];
     const V3<Exact> nw = newell_normal<Exact>(static_cast<int>(cyc.size()),
                                               [&](int i) -> const V3<Exact>& { return vertex[cyc[i]]; });
-    if (CGAL::sign(dot(nw, hs[face_halfspace[0]].normal)) < 0)
+    if (CGAL::sign(dot(nw, to_rational(hs[face_halfspace[0]].normal))) < 0)
       for (auto& c : faces) std::reverse(c.begin(), c.end());
   }
   std::vector<V3<double>> rounded(vertex.size());
   for (std::size_t v = 0; v < vertex.size(); ++v)
     rounded[v] = {round_to_nearest(vertex[v].x), round_to_nearest(vertex[v].y), round_to_nearest(vertex[v].z)};
-  Polytope p = make_polytope(std::move(rounded), std::move(vertex), faces, "A (-) B");
+  std::vector<V3<ExactN>> normals(faces.size());
+  for (std::size_t f = 0; f < faces.size(); ++f) normals[f] = hs[face_halfspace[f]].normal;
+  Polytope p = make_polytope(std::move(rounded), std::move(vertex), faces, std::move(normals), "A (-) B");
   for (auto& s : p.face_source) s = face_source[s];
   out.polytope = std::move(p);
   return out;
@@ -184,10 +188,10 @@ MaybePolytope erode_polytope(const Polytope& A, const Polytope& B) {
   std::vector<HalfSpace> hs(nf);
   parallel_chunks(nf, 64, [&](int begin, int end) {
     for (int f = begin; f < end; ++f) {
-      const V3<Exact>& n = A.exact_normal(f);
+      const V3<Exact> n = to_rational(A.exact_normal(f));
       Exact offset = dot(n, A.exact_point(A.corner(f, 0)));
       for (int k = 1; k < A.degree(f); ++k) offset = std::max(offset, dot(n, A.exact_point(A.corner(f, k))));
-      hs[f] = {n, offset - dot(n, B.exact_point(location_vertex(B, loc[f]))), A.face_source[f]};
+      hs[f] = {A.exact_normal(f), offset - dot(n, B.exact_point(location_vertex(B, loc[f]))), A.face_source[f]};
     }
   });
   // A point usually inside: A's vertex centroid minus B's.

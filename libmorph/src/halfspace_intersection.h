@@ -15,7 +15,7 @@ namespace morph::detail {
 /// A closed half-space { x : <normal, x> <= offset }, exact. `source` is a facet index
 /// carried to the result's facet labels.
 struct HalfSpace {
-  V3<Exact> normal;
+  V3<ExactN> normal;  // dyadic: a facet normal of a polytope with double points
   Exact offset;
   int source = -1;
 };

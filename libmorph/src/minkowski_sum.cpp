@@ -226,10 +226,21 @@ Polytope sum_polytope(const Polytope& A, const Polytope& B, const SumFacets& fac
     exact[v] = A.exact_point(pair_first(pairs[v])) + B.exact_point(pair_second(pairs[v]));
     points[v] = {round_to_nearest(exact[v].x), round_to_nearest(exact[v].y), round_to_nearest(exact[v].z)};
   }
+  if (!A.exact_points.empty() || !B.exact_points.empty())
+    throw error("internal error: an exact sum needs operands with double points");
   std::vector<std::vector<int>> faces(facets.num_faces());
-  for (int f = 0; f < facets.num_faces(); ++f)
+  std::vector<V3<ExactN>> normals(facets.num_faces());
+  std::vector<V3<ExactN>> cycle;
+  for (int f = 0; f < facets.num_faces(); ++f) {
     faces[f].assign(corners.begin() + facets.face_begin[f], corners.begin() + facets.face_begin[f + 1]);
-  return make_polytope(std::move(points), std::move(exact), faces, "A (+) B");
+    cycle.clear();
+    for (int c = facets.face_begin[f]; c < facets.face_begin[f + 1]; ++c)
+      cycle.push_back(to_exact_n(A.points[pair_first(facets.corners[c])]) +
+                      to_exact_n(B.points[pair_second(facets.corners[c])]));
+    normals[f] = newell_normal<ExactN>(static_cast<int>(cycle.size()),
+                                       [&](int i) -> const V3<ExactN>& { return cycle[i]; });
+  }
+  return make_polytope(std::move(points), std::move(exact), faces, std::move(normals), "A (+) B");
 }
 
 Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& face_begin,

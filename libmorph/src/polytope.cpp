@@ -20,14 +20,15 @@ double round_to_nearest(const Exact& q) {
   return d;
 }
 
-const V3<Exact>& Polytope::exact_normal(int f) const {
+const V3<ExactN>& Polytope::exact_normal(int f) const {
+  if (!given_normals.empty()) return given_normals[f];
   ExactCache& cache = *exact_cache_;
   std::call_once(cache.once[f], [&] {
     const int b = face_begin[f];
-    std::vector<V3<Exact>> cycle;
+    std::vector<V3<ExactN>> cycle;
     cycle.reserve(degree(f));
-    for (int k = 0; k < degree(f); ++k) cycle.push_back(exact_point(corner_vertex[b + k]));
-    cache.value[f] = newell_normal<Exact>(degree(f), [&](int i) -> const V3<Exact>& { return cycle[i]; });
+    for (int k = 0; k < degree(f); ++k) cycle.push_back(to_exact_n(points[corner_vertex[b + k]]));
+    cache.value[f] = newell_normal<ExactN>(degree(f), [&](int i) -> const V3<ExactN>& { return cycle[i]; });
   });
   return cache.value[f];
 }
@@ -45,7 +46,7 @@ void Polytope::compute_normals() {
   }
   exact_cache_ = std::make_shared<ExactCache>();
   exact_cache_->once = std::make_unique<std::once_flag[]>(nf);
-  exact_cache_->value = std::make_unique<V3<Exact>[]>(nf);
+  exact_cache_->value = std::make_unique<V3<ExactN>[]>(nf);
 }
 
 namespace {
@@ -54,13 +55,6 @@ std::uint64_t key(int u, int w) {
   return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(u)) << 32) | static_cast<std::uint32_t>(w);
 }
 
-/// The vector from vertex u to vertex w of a polytope, as a predicate argument.
-struct EdgeVector {
-  const Polytope* p;
-  int u, w;
-  V3<Interval> approx() const { return p->interval_point(w) - p->interval_point(u); }
-  V3<Exact> exact() const { return p->exact_point(w) - p->exact_point(u); }
-};
 
 struct UnionFind {
   std::vector<int> parent;
@@ -157,15 +151,25 @@ void build_connectivity(Polytope& p, const std::vector<std::vector<int>>& faces,
       fail(name, "vertex " + std::to_string(v) + " is not manifold");
 }
 
+/// Sign of det(N_left, N_right, to - from): positive when the edge is strictly convex.
 int edge_convexity(const Polytope& p, const Polytope::Edge& e) {
-  return filtered_sign([](const auto& a, const auto& b, const auto& d) { return det(a, b, d); },
-                       NormalRef{&p, e.left}, NormalRef{&p, e.right}, EdgeVector{&p, e.from, e.to});
+  const int s = interval_sign(
+      det(p.normals[e.left], p.normals[e.right], p.interval_point(e.to) - p.interval_point(e.from)));
+  if (s != 2) return s;
+  if (p.exact_points.empty())
+    return CGAL::sign(det(p.exact_normal(e.left), p.exact_normal(e.right),
+                          to_exact_n(p.points[e.to]) - to_exact_n(p.points[e.from])));
+  return CGAL::sign(det(to_rational(p.exact_normal(e.left)), to_rational(p.exact_normal(e.right)),
+                        p.exact_point(e.to) - p.exact_point(e.from)));
 }
 
 }  // namespace
 
 Polytope make_polytope(std::vector<V3<double>> points, std::vector<V3<Exact>> exact_points,
-                       const std::vector<std::vector<int>>& input_faces, const char* name) {
+                       const std::vector<std::vector<int>>& input_faces, std::vector<V3<ExactN>> given_normals,
+                       const char* name) {
+  if (!exact_points.empty() && given_normals.size() != input_faces.size())
+    throw error("internal error: a polytope with exact points needs one exact normal per facet");
   std::vector<std::vector<int>> faces = input_faces;
   std::vector<int> face_source(faces.size());
   std::iota(face_source.begin(), face_source.end(), 0);
@@ -174,6 +178,10 @@ Polytope make_polytope(std::vector<V3<double>> points, std::vector<V3<Exact>> ex
   p.exact_points = std::move(exact_points);
   for (int round = 0;; ++round) {
     build_connectivity(p, faces, name);
+    if (!given_normals.empty()) {
+      p.given_normals.resize(faces.size());
+      for (std::size_t f = 0; f < faces.size(); ++f) p.given_normals[f] = given_normals[face_source[f]];
+    }
     p.compute_normals();
     UnionFind groups(p.num_faces());
     bool merged = false;
@@ -268,6 +276,8 @@ Polytope make_polytope(std::vector<V3<double>> points, std::vector<V3<Exact>> ex
     p.exact_points = std::move(epts);
     p.vertex_source = std::move(vsrc);
     build_connectivity(p, faces, name);
+    if (!given_normals.empty())
+      for (std::size_t f = 0; f < faces.size(); ++f) p.given_normals[f] = given_normals[face_source[f]];
     p.compute_normals();
   } else {
     p.vertex_source.resize(used);
@@ -311,7 +321,7 @@ Polytope make_polytope(const Mesh& mesh, const char* name) {
     for (auto v : f.vertices()) cyc.push_back(v.idx());
     faces.push_back(std::move(cyc));
   }
-  Polytope p = make_polytope(std::move(points), {}, faces, name);
+  Polytope p = make_polytope(std::move(points), {}, faces, {}, name);
   for (int e = 0; e < p.num_edges(); ++e) {
     const int u = p.vertex_source[p.edges[e].from], w = p.vertex_source[p.edges[e].to];
     auto h = mesh.find_halfedge(mesh.vertex_handle(u), mesh.vertex_handle(w));

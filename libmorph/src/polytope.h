@@ -35,6 +35,9 @@ struct Polytope {
   // Vertices: rounded positions, and exact ones when they are not doubles.
   std::vector<V3<double>> points;
   std::vector<V3<Exact>> exact_points;  // empty when `points` are exact
+  // Exact facet normals when `exact_points` is used (the normal of the plane the facet was
+  // built on); empty otherwise, the normals being Newell's of the double points.
+  std::vector<V3<ExactN>> given_normals;
 
   // Facets: counter-clockwise vertex cycles about the outward normal.
   std::vector<int> face_begin;     // size F + 1
@@ -69,8 +72,9 @@ struct Polytope {
     return exact_points.empty() ? to_interval(points[v]) : to_interval(exact_points[v]);
   }
 
-  /// Exact Newell normal of facet f, computed once on first use (thread-safe).
-  const V3<Exact>& exact_normal(int f) const;
+  /// Exact normal of facet f: given, or Newell's of its points, computed once on first
+  /// use (thread-safe).
+  const V3<ExactN>& exact_normal(int f) const;
 
   /// Computes `normals` and resets the exact cache; call after the facets are final.
   void compute_normals();
@@ -78,7 +82,7 @@ struct Polytope {
  private:
   struct ExactCache {
     std::unique_ptr<std::once_flag[]> once;
-    std::unique_ptr<V3<Exact>[]> value;
+    std::unique_ptr<V3<ExactN>[]> value;
   };
   mutable std::shared_ptr<ExactCache> exact_cache_;
 };
@@ -88,7 +92,7 @@ struct NormalRef {
   const Polytope* polytope;
   int face;
   const V3<Interval>& approx() const { return polytope->normals[face]; }
-  const V3<Exact>& exact() const { return polytope->exact_normal(face); }
+  const V3<ExactN>& exact() const { return polytope->exact_normal(face); }
 };
 
 /// Builds the canonical polytope of a mesh that passed prepare_convex_polyhedron().
@@ -97,10 +101,11 @@ struct NormalRef {
 Polytope make_polytope(const Mesh& mesh, const char* name);
 
 /// Builds a polytope from facet cycles over the given vertices (exact positions when
-/// `exact_points` is non-empty), canonicalising it as make_polytope does. Vertices not
-/// used by any facet are dropped.
+/// `exact_points` is non-empty, and then one exact normal per facet in `given_normals`),
+/// canonicalising it as make_polytope does. Vertices not used by any facet are dropped.
 Polytope make_polytope(std::vector<V3<double>> points, std::vector<V3<Exact>> exact_points,
-                       const std::vector<std::vector<int>>& faces, const char* name);
+                       const std::vector<std::vector<int>>& faces, std::vector<V3<ExactN>> given_normals,
+                       const char* name);
 
 /// The mesh of a polytope (its rounded positions), with facets in polytope order.
 Mesh to_mesh(const Polytope& p);
