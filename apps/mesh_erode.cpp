@@ -1,4 +1,6 @@
 // mesh-erode: see 'mesh-erode --help' and docs/cli.md.
 #include "common/options.h"
 
-int main(int argc, char* argv[]) { return morph::cli::run_operation_app(argc, argv, morph::cli::Op::erode); }
+int main(int argc, char* argv[]) {
+  return morph::cli::run_operation_app(argc, argv, morph::cli::Op::erode);
+}

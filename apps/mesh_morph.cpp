@@ -1,14 +1,7 @@
 // mesh-morph: chains of operations (--op, --pipeline), mesh checking and conversion,
 // and batches of many inputs processed in parallel.
-#include "common/batch.h"
-#include "common/cli.h"
-#include "common/job.h"
-#include "common/options.h"
-#include "common/pipeline.h"
-
 #include <morph/error.h>
 #include <morph/version.h>
-
 #include <unistd.h>
 
 #include <filesystem>
@@ -17,6 +10,12 @@
 #include <iterator>
 #include <map>
 #include <sstream>
+
+#include "common/batch.h"
+#include "common/cli.h"
+#include "common/job.h"
+#include "common/options.h"
+#include "common/pipeline.h"
 
 namespace fs = std::filesystem;
 using namespace morph::cli;
@@ -30,18 +29,26 @@ std::string usage(const po::options_description& visible) {
   std::ostringstream out;
   out << "Usage: mesh-morph INPUT [-o OUTPUT] [--op \"OP SPEC\"]... [options]\n"
       << "       mesh-morph INPUT [-o OUTPUT] --pipeline FILE [options]\n"
-      << "       mesh-morph INPUT... | DIR | --list FILE  --output-dir DIR [--report CSV] [options]\n\n"
-      << "Runs a chain of morphological operations on a convex polyhedron in one process: each --op\n"
-      << "(or each line of a pipeline file) is OP SPEC, OP one of dilate, erode, open, close and SPEC a\n"
-      << "structuring element. With no operation it checks that INPUT is a closed convex polyhedron\n"
+      << "       mesh-morph INPUT... | DIR | --list FILE  --output-dir DIR [--report CSV] "
+         "[options]\n\n"
+      << "Runs a chain of morphological operations on a convex polyhedron in one process: each "
+         "--op\n"
+      << "(or each line of a pipeline file) is OP SPEC, OP one of dilate, erode, open, close and "
+         "SPEC a\n"
+      << "structuring element. With no operation it checks that INPUT is a closed convex "
+         "polyhedron\n"
       << "(exit 0 if so, 3 if not) and converts it when -o is given; -v prints a summary line.\n"
       << "An empty result stops the chain; an empty mesh is written, with a warning.\n\n"
-      << "Several INPUTs, a directory (its .off .obj .ply .stl files) or --list make a batch: the files\n"
-      << "are processed in parallel, results go to --output-dir named after the inputs, one bad file\n"
-      << "never stops the others (exit 1, the summary names the failures). Ctrl-C lets the files in\n"
+      << "Several INPUTs, a directory (its .off .obj .ply .stl files) or --list make a batch: the "
+         "files\n"
+      << "are processed in parallel, results go to --output-dir named after the inputs, one bad "
+         "file\n"
+      << "never stops the others (exit 1, the summary names the failures). Ctrl-C lets the files "
+         "in\n"
       << "progress finish, starts no new one, and exits 130; no partial file is left.\n\n"
       << visible << "\n"
-      << "Pipeline files: one step 'OP SPEC' per line; '#' starts a comment (at the start of a line or\n"
+      << "Pipeline files: one step 'OP SPEC' per line; '#' starts a comment (at the start of a "
+         "line or\n"
       << "after a space); blank lines are ignored. Example (samples/pipelines/clean.morph):\n"
       << "  # remove spikes, then fill dents\n"
       << "  open  sphere:r=0.05,level=2\n"
@@ -49,11 +56,14 @@ std::string usage(const po::options_description& visible) {
       << se_grammar_help() << "\n"
       << label_palette_help() << "\n"
       << "Examples:\n"
-      << "  mesh-morph part.off -v                                    check a mesh, print a summary\n"
+      << "  mesh-morph part.off -v                                    check a mesh, print a "
+         "summary\n"
       << "  mesh-morph part.stl -o part.ply --binary                  convert\n"
-      << "  mesh-morph in.off -o out.ply --op \"open sphere:r=0.05,level=2\" --op \"close box:0.1,0.1,0.1\"\n"
+      << "  mesh-morph in.off -o out.ply --op \"open sphere:r=0.05,level=2\" --op \"close "
+         "box:0.1,0.1,0.1\"\n"
       << "  mesh-morph in.off -o out.ply --pipeline samples/pipelines/clean.morph --stats\n"
-      << "  mesh-morph meshes/ --output-dir out/ --format ply --op \"dilate cube:0.1\" --report results.csv\n"
+      << "  mesh-morph meshes/ --output-dir out/ --format ply --op \"dilate cube:0.1\" --report "
+         "results.csv\n"
       << "  mesh-morph --list inputs.txt --output-dir out/ --pipeline clean.morph --threads 8\n\n"
       << kExitCodeHelp;
   return out.str();
@@ -61,7 +71,8 @@ std::string usage(const po::options_description& visible) {
 
 std::vector<PipelineStep> read_pipeline_file(const std::string& path) {
   std::error_code ec;
-  if (fs::is_directory(path, ec)) throw morph::io_error(path + ": is a directory, not a pipeline file");
+  if (fs::is_directory(path, ec))
+    throw morph::io_error(path + ": is a directory, not a pipeline file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw morph::io_error(path + ": cannot open the pipeline file: " + std::strerror(errno));
   const std::uintmax_t size = fs::file_size(path, ec);
@@ -145,7 +156,8 @@ int run(int argc, const char* const argv[], Reporter& reporter) {
   reporter.set_verbose(common.verbose);
 
   // The steps.
-  if (!ops.empty() && !pipeline_file.empty()) return usage_error(reporter, "give either --op or --pipeline, not both");
+  if (!ops.empty() && !pipeline_file.empty())
+    return usage_error(reporter, "give either --op or --pipeline, not both");
   std::vector<PipelineStep> steps;
   try {
     if (!pipeline_file.empty()) {
@@ -169,10 +181,12 @@ int run(int argc, const char* const argv[], Reporter& reporter) {
     }
   }
   if (inputs.empty()) {
-    return usage_error(reporter, list_file.empty() ? "missing INPUT (a mesh file, a directory, or '-' for stdin)"
-                                                   : list_file + " lists no input");
+    return usage_error(reporter, list_file.empty()
+                                     ? "missing INPUT (a mesh file, a directory, or '-' for stdin)"
+                                     : list_file + " lists no input");
   }
-  bool batch_mode = !output_dir.empty() || !list_file.empty() || !report_file.empty() || inputs.size() > 1;
+  bool batch_mode =
+      !output_dir.empty() || !list_file.empty() || !report_file.empty() || inputs.size() > 1;
   std::vector<std::string> files;
   for (const std::string& input : inputs) {
     std::error_code ec;
@@ -181,8 +195,9 @@ int run(int argc, const char* const argv[], Reporter& reporter) {
       try {
         const std::vector<std::string> found = list_directory_meshes(input);
         if (found.empty()) {
-          return fail(reporter, make_failure(kExitNoInput, input, "no .off, .obj, .ply or .stl file in the directory",
-                                             kProgram));
+          return fail(reporter,
+                      make_failure(kExitNoInput, input,
+                                   "no .off, .obj, .ply or .stl file in the directory", kProgram));
         }
         files.insert(files.end(), found.begin(), found.end());
       } catch (...) {
@@ -201,7 +216,8 @@ int run(int argc, const char* const argv[], Reporter& reporter) {
   settings.op_label = steps.empty() ? "check" : describe_steps(steps);
 
   if (!batch_mode) {
-    if (std::optional<Failure> failure = prepare_steps(steps, reporter, settings.steps)) return fail(reporter, *failure);
+    if (std::optional<Failure> failure = prepare_steps(steps, reporter, settings.steps))
+      return fail(reporter, *failure);
     install_interrupt_handler(kProgram, InterruptMode::immediate_when_safe);
     if (!steps.empty() && common.output.empty()) {
       reporter.warning("", "no -o OUTPUT given: the result is computed but not written");
@@ -213,7 +229,9 @@ int run(int argc, const char* const argv[], Reporter& reporter) {
 
   // Batch: check everything that concerns the whole batch before any work.
   if (!common.output.empty()) {
-    return usage_error(reporter, "-o names one output; with several inputs, a directory or --list use --output-dir DIR");
+    return usage_error(
+        reporter,
+        "-o names one output; with several inputs, a directory or --list use --output-dir DIR");
   }
   std::vector<Job> jobs;
   std::map<std::string, std::string> output_owner;  // output identity -> the input writing it
@@ -229,12 +247,13 @@ int run(int argc, const char* const argv[], Reporter& reporter) {
       const std::string id = identity(job.output);
       const auto [it, inserted] = output_owner.emplace(id, file);
       if (!inserted) {
-        return usage_error(reporter, "'" + it->second + "' and '" + file + "' would both be written to '" + job.output +
+        return usage_error(reporter, "'" + it->second + "' and '" + file +
+                                         "' would both be written to '" + job.output +
                                          "'; rename one, or use another --format");
       }
       if (const auto in = input_identities.find(id); in != input_identities.end()) {
-        return usage_error(reporter, "the result of '" + file + "' would overwrite the input '" + in->second +
-                                         "'; choose another --output-dir");
+        return usage_error(reporter, "the result of '" + file + "' would overwrite the input '" +
+                                         in->second + "'; choose another --output-dir");
       }
     }
     jobs.push_back(std::move(job));
@@ -244,21 +263,24 @@ int run(int argc, const char* const argv[], Reporter& reporter) {
     fs::create_directories(output_dir, ec);
     if (ec || !fs::is_directory(output_dir)) {
       return fail(reporter, make_failure(kExitCantCreate, output_dir,
-                                         "cannot create the output directory" + (ec ? ": " + ec.message() : ""),
+                                         "cannot create the output directory" +
+                                             (ec ? ": " + ec.message() : ""),
                                          kProgram));
     }
   } else if (!steps.empty()) {
     reporter.warning("", "no --output-dir given: the results are computed but not written");
   }
   if (!report_file.empty()) {
-    const fs::path parent = fs::path(report_file).has_parent_path() ? fs::path(report_file).parent_path() : ".";
+    const fs::path parent =
+        fs::path(report_file).has_parent_path() ? fs::path(report_file).parent_path() : ".";
     std::error_code ec;
     if (!fs::is_directory(parent, ec)) {
-      return fail(reporter,
-                  make_failure(kExitCantCreate, report_file, "the report's directory does not exist", kProgram));
+      return fail(reporter, make_failure(kExitCantCreate, report_file,
+                                         "the report's directory does not exist", kProgram));
     }
   }
-  if (std::optional<Failure> failure = prepare_steps(steps, reporter, settings.steps)) return fail(reporter, *failure);
+  if (std::optional<Failure> failure = prepare_steps(steps, reporter, settings.steps))
+    return fail(reporter, *failure);
 
   install_interrupt_handler(kProgram, InterruptMode::graceful);
   const bool progress = !common.quiet && ::isatty(STDERR_FILENO) == 1;

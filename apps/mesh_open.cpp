@@ -1,4 +1,6 @@
 // mesh-open: see 'mesh-open --help' and docs/cli.md.
 #include "common/options.h"
 
-int main(int argc, char* argv[]) { return morph::cli::run_operation_app(argc, argv, morph::cli::Op::open); }
+int main(int argc, char* argv[]) {
+  return morph::cli::run_operation_app(argc, argv, morph::cli::Op::open);
+}

@@ -1,11 +1,9 @@
 #include "batch.h"
 
 #include <morph/error.h>
-
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/partitioner.h>
-
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -56,7 +54,8 @@ std::vector<std::string> read_list_file(const std::string& path) {
 std::string batch_output_path(const std::string& input, const std::string& output_dir,
                               std::optional<MeshFormat> format) {
   const fs::path in(input);
-  const std::string ext = format ? std::string(".") + format_name(*format) : in.extension().string();
+  const std::string ext =
+      format ? std::string(".") + format_name(*format) : in.extension().string();
   return (fs::path(output_dir) / (in.stem().string() + ext)).string();
 }
 
@@ -65,9 +64,10 @@ namespace {
 std::string progress_bar(std::size_t done, std::size_t total, std::size_t failed) {
   constexpr std::size_t kWidth = 30;
   const std::size_t filled = total == 0 ? kWidth : done * kWidth / total;
-  std::string bar = "[" + std::string(filled, '#') + std::string(kWidth - filled, '.') + "] " +
-                    std::to_string(done) + "/" + std::to_string(total);
-  if (failed > 0) bar += ", " + std::to_string(failed) + " failed";
+  std::string bar(1, '[');
+  bar.append(filled, '#').append(kWidth - filled, '.').append("] ");
+  bar.append(std::to_string(done)).append("/").append(std::to_string(total));
+  if (failed > 0) bar.append(", ").append(std::to_string(failed)).append(" failed");
   return bar;
 }
 
@@ -76,15 +76,15 @@ std::string file_line(const Job& job, const JobResult& result) {
   if (!job.output.empty()) line += " -> " + job.output;
   char ms[32];
   std::snprintf(ms, sizeof ms, "%.1f", result.stats.compute_ms);
-  line += " (" + std::to_string(result.stats.vertices) + " vertices, " + std::to_string(result.stats.facets) +
-          " facets, " + ms + " ms)";
+  line += " (" + std::to_string(result.stats.vertices) + " vertices, " +
+          std::to_string(result.stats.facets) + " facets, " + ms + " ms)";
   return line;
 }
 
 }  // namespace
 
-std::vector<JobResult> run_batch(const std::vector<Job>& jobs, const JobSettings& settings, Reporter& reporter,
-                                 bool progress_bar_on) {
+std::vector<JobResult> run_batch(const std::vector<Job>& jobs, const JobSettings& settings,
+                                 Reporter& reporter, bool progress_bar_on) {
   std::vector<JobResult> results(jobs.size());
   std::atomic<std::size_t> done{0};
   std::atomic<std::size_t> failed{0};
@@ -110,7 +110,8 @@ std::vector<JobResult> run_batch(const std::vector<Job>& jobs, const JobSettings
             reporter.info(file_line(jobs[i], result));
           }
           const std::size_t finished = ++done;
-          if (progress_bar_on) reporter.show_progress(progress_bar(finished, jobs.size(), failed.load()));
+          if (progress_bar_on)
+            reporter.show_progress(progress_bar(finished, jobs.size(), failed.load()));
         }
       },
       tbb::simple_partitioner());
@@ -162,7 +163,8 @@ std::string csv_field(std::string_view text) {
   return out + "\"";
 }
 
-void write_report(const std::string& path, const std::vector<Job>& jobs, const std::vector<JobResult>& results) {
+void write_report(const std::string& path, const std::vector<Job>& jobs,
+                  const std::vector<JobResult>& results) {
   std::ostringstream csv;
   csv << "file,status,vertices,facets,compute_ms,message\n";
   for (std::size_t i = 0; i < results.size(); ++i) {
@@ -180,7 +182,8 @@ void write_report(const std::string& path, const std::vector<Job>& jobs, const s
   // Atomic like the mesh writers: a temporary beside the target, then a rename.
   const fs::path target(path);
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  std::string temp = (dir / ("." + target.filename().string() + ".XXXXXX")).string();
+  std::string temp =
+      (dir / std::string(1, '.').append(target.filename().string()).append(".XXXXXX")).string();
   WriteInProgress writing;
   const int fd = ::mkstemp(temp.data());
   if (fd < 0) throw io_error(path + ": cannot create the report: " + std::strerror(errno));

@@ -1,11 +1,11 @@
 // Batches: many inputs, processed in parallel, one bad file never stopping the others.
 #pragma once
 
-#include "job.h"
-
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "job.h"
 
 namespace morph::cli {
 
@@ -27,8 +27,8 @@ std::string batch_output_path(const std::string& input, const std::string& outpu
 /// started (those are `skipped`); jobs in progress finish. Prints one line per file
 /// (ok/empty on stderr unless --quiet, failures always) and, when `progress_bar`, a
 /// progress bar kept at the bottom of the terminal.
-std::vector<JobResult> run_batch(const std::vector<Job>& jobs, const JobSettings& settings, Reporter& reporter,
-                                 bool progress_bar);
+std::vector<JobResult> run_batch(const std::vector<Job>& jobs, const JobSettings& settings,
+                                 Reporter& reporter, bool progress_bar);
 
 /// The closing line: counts by status and the names of the failed inputs.
 std::string batch_summary(const std::vector<Job>& jobs, const std::vector<JobResult>& results);
@@ -38,7 +38,8 @@ int batch_exit_code(const std::vector<JobResult>& results);
 
 /// Writes the CSV report (columns file,status,vertices,facets,compute_ms,message)
 /// atomically: a temporary file beside `path`, then a rename. Throws io_error.
-void write_report(const std::string& path, const std::vector<Job>& jobs, const std::vector<JobResult>& results);
+void write_report(const std::string& path, const std::vector<Job>& jobs,
+                  const std::vector<JobResult>& results);
 
 /// One CSV field, quoted when it holds a comma, a quote or a line break.
 std::string csv_field(std::string_view text);

@@ -2,11 +2,9 @@
 
 #include <morph/error.h>
 #include <morph/validate.h>
-
 #include <oneapi/tbb/global_control.h>
 #include <oneapi/tbb/info.h>
 #include <oneapi/tbb/task_arena.h>
-
 #include <unistd.h>
 
 #include <algorithm>
@@ -104,16 +102,24 @@ namespace {
 
 std::string default_hint(int code, std::string_view program) {
   switch (code) {
-    case kExitUsage: return "Run '" + std::string(program) + " --help' for usage";
-    case kExitDataErr: return "Check that it is a valid OFF, OBJ, PLY or STL mesh";
-    case kExitNoInput: return "Check that the path exists and is readable";
+    case kExitUsage:
+      return "Run '" + std::string(program) + " --help' for usage";
+    case kExitDataErr:
+      return "Check that it is a valid OFF, OBJ, PLY or STL mesh";
+    case kExitNoInput:
+      return "Check that the path exists and is readable";
     case kExitInvalidMesh:
-      return "Operands must be closed convex polyhedra with outward facets (see docs/cli.md, 'Inputs')";
-    case kExitCantCreate: return "Check that the directory exists and is writable";
+      return "Operands must be closed convex polyhedra with outward facets (see docs/cli.md, "
+             "'Inputs')";
+    case kExitCantCreate:
+      return "Check that the directory exists and is writable";
     case kExitEmpty:
-      return "The structuring element fits nowhere inside the input; use a smaller one, or drop --fail-on-empty";
-    case kExitSoftware: return "This is a bug; please report it with the command line and input files";
-    default: return "";
+      return "The structuring element fits nowhere inside the input; use a smaller one, or drop "
+             "--fail-on-empty";
+    case kExitSoftware:
+      return "This is a bug; please report it with the command line and input files";
+    default:
+      return "";
   }
 }
 
@@ -131,8 +137,10 @@ std::string without_file_prefix(std::string what, std::string_view file) {
 
 }  // namespace
 
-Failure make_failure(int code, std::string_view file, std::string_view what, std::string_view program) {
-  return Failure{code, std::string(file), without_file_prefix(std::string(what), file), default_hint(code, program)};
+Failure make_failure(int code, std::string_view file, std::string_view what,
+                     std::string_view program) {
+  return Failure{code, std::string(file), without_file_prefix(std::string(what), file),
+                 default_hint(code, program)};
 }
 
 Failure classify_current_exception(Stage stage, std::string_view file, std::string_view program) {
@@ -147,13 +155,14 @@ Failure classify_current_exception(Stage stage, std::string_view file, std::stri
     code = kExitInvalidMesh;
     what = e.what();
   } catch (const io_error& e) {
-    code = stage == Stage::write ? kExitCantCreate
+    code = stage == Stage::write                                 ? kExitCantCreate
            : stage == Stage::compute || stage == Stage::validate ? kExitSoftware
                                                                  : kExitNoInput;
     what = e.what();
   } catch (const input_error& e) {  // limit_error included
-    code = stage == Stage::usage || stage == Stage::structuring_element || stage == Stage::write ? kExitUsage
-                                                                                                  : kExitDataErr;
+    code = stage == Stage::usage || stage == Stage::structuring_element || stage == Stage::write
+               ? kExitUsage
+               : kExitDataErr;
     what = e.what();
   } catch (const std::exception& e) {
     code = kExitSoftware;
@@ -204,13 +213,16 @@ extern "C" void on_sigint(int) {
   const int saved_errno = errno;
   const int count = g_signal_count.fetch_add(1) + 1;
   g_interrupted.store(true);
-  const bool immediate = g_mode.load() == static_cast<int>(InterruptMode::immediate_when_safe) || count >= 2;
+  const bool immediate =
+      g_mode.load() == static_cast<int>(InterruptMode::immediate_when_safe) || count >= 2;
   if (immediate && g_writes_in_progress.load() == 0) {
-    [[maybe_unused]] ssize_t ignored = ::write(STDERR_FILENO, g_exit_message, g_exit_message_length);
+    [[maybe_unused]] ssize_t ignored =
+        ::write(STDERR_FILENO, g_exit_message, g_exit_message_length);
     ::_exit(kExitInterrupted);
   }
   if (count == 1 && g_mode.load() == static_cast<int>(InterruptMode::graceful)) {
-    [[maybe_unused]] ssize_t ignored = ::write(STDERR_FILENO, g_graceful_message, g_graceful_message_length);
+    [[maybe_unused]] ssize_t ignored =
+        ::write(STDERR_FILENO, g_graceful_message, g_graceful_message_length);
   }
   errno = saved_errno;
 }
@@ -219,9 +231,12 @@ extern "C" void on_sigint(int) {
 
 void install_interrupt_handler(std::string_view program, InterruptMode mode) {
   const std::string prefix = std::string("\n").append(program);
-  prepare_message(g_exit_message, g_exit_message_length, prefix + ": interrupted; no partial output was left\n");
+  prepare_message(g_exit_message, g_exit_message_length,
+                  prefix + ": interrupted; no partial output was left\n");
   prepare_message(g_graceful_message, g_graceful_message_length,
-                  prefix + ": interrupted; finishing the files in progress, starting no new one (Ctrl-C again to stop now)\n");
+                  prefix +
+                      ": interrupted; finishing the files in progress, starting no new one (Ctrl-C "
+                      "again to stop now)\n");
   g_mode.store(static_cast<int>(mode));
   struct sigaction action {};
   action.sa_handler = on_sigint;
@@ -254,11 +269,13 @@ ThreadLimit::~ThreadLimit() = default;
 
 Mesh read_input(const std::string& path, std::optional<MeshFormat> format) {
   if (path == kStdStream) {
-    if (!format) throw input_error("reading stdin needs --input-format (or --format) off|obj|ply|stl");
+    if (!format)
+      throw input_error("reading stdin needs --input-format (or --format) off|obj|ply|stl");
     return read_mesh(std::cin, *format, "<stdin>");
   }
   std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw io_error(path + ": is a directory, not a mesh file");
+  if (std::filesystem::is_directory(path, ec))
+    throw io_error(path + ": is a directory, not a mesh file");
   if (!format) return read_mesh(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw io_error(path + ": cannot open: " + std::strerror(errno));
@@ -267,7 +284,8 @@ Mesh read_input(const std::string& path, std::optional<MeshFormat> format) {
 
 MeshFormat output_format_for(const std::string& path, std::optional<MeshFormat> explicit_format) {
   if (explicit_format) return *explicit_format;
-  if (path == kStdStream) throw input_error("writing to stdout ('-o -') needs --format off|obj|ply|stl");
+  if (path == kStdStream)
+    throw input_error("writing to stdout ('-o -') needs --format off|obj|ply|stl");
   const std::string ext = std::filesystem::path(path).extension().string();
   if (!has_mesh_extension(path)) {
     throw input_error("cannot tell the output format from the extension '" + ext +
@@ -276,7 +294,8 @@ MeshFormat output_format_for(const std::string& path, std::optional<MeshFormat> 
   return format_from_path(path);
 }
 
-void write_output(const Mesh& mesh, const std::string& path, MeshFormat format, const WriteOptions& options) {
+void write_output(const Mesh& mesh, const std::string& path, MeshFormat format,
+                  const WriteOptions& options) {
   WriteInProgress writing;
   if (path == kStdStream) {
     write_mesh(mesh, std::cout, format, options);
@@ -291,17 +310,22 @@ void write_output(const Mesh& mesh, const std::string& path, MeshFormat format, 
 
 const char* format_name(MeshFormat format) {
   switch (format) {
-    case MeshFormat::off: return "off";
-    case MeshFormat::obj: return "obj";
-    case MeshFormat::ply: return "ply";
-    case MeshFormat::stl: return "stl";
+    case MeshFormat::off:
+      return "off";
+    case MeshFormat::obj:
+      return "obj";
+    case MeshFormat::ply:
+      return "ply";
+    case MeshFormat::stl:
+      return "stl";
   }
   return "?";
 }
 
 bool has_mesh_extension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   return ext == ".off" || ext == ".obj" || ext == ".ply" || ext == ".stl";
 }
 
@@ -312,9 +336,15 @@ std::vector<Color> facet_colors(const std::vector<FacetOrigin>& origins) {
   colors.reserve(origins.size());
   for (const FacetOrigin& origin : origins) {
     switch (origin.kind) {
-      case FacetKind::translated: colors.push_back(kTranslatedColor); break;
-      case FacetKind::corner: colors.push_back(kCornerColor); break;
-      case FacetKind::edge: colors.push_back(kEdgeColor); break;
+      case FacetKind::translated:
+        colors.push_back(kTranslatedColor);
+        break;
+      case FacetKind::corner:
+        colors.push_back(kCornerColor);
+        break;
+      case FacetKind::edge:
+        colors.push_back(kEdgeColor);
+        break;
     }
   }
   return colors;

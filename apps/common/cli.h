@@ -3,8 +3,6 @@
 // colours and the --stats JSON line.
 #pragma once
 
-#include "exit_codes.h"
-
 #include <morph/io.h>
 #include <morph/minkowski_sum.h>
 
@@ -14,6 +12,8 @@
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "exit_codes.h"
 
 namespace morph::cli {
 
@@ -79,7 +79,8 @@ struct Failure {
 Failure classify_current_exception(Stage stage, std::string_view file, std::string_view program);
 
 /// A failure of the given code with the standard hint for it.
-Failure make_failure(int code, std::string_view file, std::string_view what, std::string_view program);
+Failure make_failure(int code, std::string_view file, std::string_view what,
+                     std::string_view program);
 
 /// Prints a failure through the reporter as one error line.
 void report(Reporter& reporter, const Failure& failure);
@@ -142,7 +143,8 @@ MeshFormat output_format_for(const std::string& path, std::optional<MeshFormat> 
 
 /// Writes `mesh` to `path` ("-" is stdout) atomically, marked as a write in progress
 /// for the SIGINT handler. Throws io_error when it cannot be written.
-void write_output(const Mesh& mesh, const std::string& path, MeshFormat format, const WriteOptions& options);
+void write_output(const Mesh& mesh, const std::string& path, MeshFormat format,
+                  const WriteOptions& options);
 
 /// The lower-case name of a format ("off", ...).
 const char* format_name(MeshFormat format);
@@ -153,9 +155,9 @@ bool has_mesh_extension(const std::string& path);
 // ---------------------------------------------------------------- facet labels
 
 /// The fixed palette of --label-facets (docs/cli.md), colour-blind safe (Okabe-Ito).
-inline constexpr Color kTranslatedColor = {0, 114, 178};   // blue: translated facets of A
-inline constexpr Color kCornerColor = {230, 159, 0};       // orange: corner facets (from B)
-inline constexpr Color kEdgeColor = {0, 158, 115};         // green: edge facets (parallelograms)
+inline constexpr Color kTranslatedColor = {0, 114, 178};  // blue: translated facets of A
+inline constexpr Color kCornerColor = {230, 159, 0};      // orange: corner facets (from B)
+inline constexpr Color kEdgeColor = {0, 158, 115};        // green: edge facets (parallelograms)
 
 /// One colour per facet origin.
 std::vector<Color> facet_colors(const std::vector<FacetOrigin>& origins);
@@ -164,7 +166,7 @@ std::vector<Color> facet_colors(const std::vector<FacetOrigin>& origins);
 
 /// What --stats reports about one run.
 struct RunStats {
-  std::string op;      // "dilate", ..., or the pipeline ("open sphere:r=1 | close cube:1")
+  std::string op;  // "dilate", ..., or the pipeline ("open sphere:r=1 | close cube:1")
   std::string input;
   std::string output;  // empty when nothing is written
   std::size_t vertices = 0;

@@ -4,15 +4,15 @@
 namespace morph::cli {
 
 enum ExitCode : int {
-  kExitOk = 0,           // success (an empty erosion/opening too, unless --fail-on-empty)
-  kExitBatchFailed = 1,  // a batch finished but some inputs failed
-  kExitInvalidMesh = 3,  // an input is not a closed convex polyhedron
-  kExitEmpty = 4,        // the result is empty and --fail-on-empty was given
-  kExitUsage = 64,       // bad option, bad --se spec, bad pipeline file
-  kExitDataErr = 65,     // malformed input file
-  kExitNoInput = 66,     // input missing or unreadable
-  kExitSoftware = 70,    // internal error
-  kExitCantCreate = 73,  // output cannot be written
+  kExitOk = 0,             // success (an empty erosion/opening too, unless --fail-on-empty)
+  kExitBatchFailed = 1,    // a batch finished but some inputs failed
+  kExitInvalidMesh = 3,    // an input is not a closed convex polyhedron
+  kExitEmpty = 4,          // the result is empty and --fail-on-empty was given
+  kExitUsage = 64,         // bad option, bad --se spec, bad pipeline file
+  kExitDataErr = 65,       // malformed input file
+  kExitNoInput = 66,       // input missing or unreadable
+  kExitSoftware = 70,      // internal error
+  kExitCantCreate = 73,    // output cannot be written
   kExitInterrupted = 130,  // interrupted by SIGINT
 };
 

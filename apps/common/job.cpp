@@ -17,7 +17,8 @@ namespace {
 class Stopwatch {
  public:
   double ms() const {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count();
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_)
+        .count();
   }
   void restart() { start_ = std::chrono::steady_clock::now(); }
 
@@ -27,19 +28,26 @@ class Stopwatch {
 
 MorphResult apply(Op op, const Mesh& a, const Mesh& b, const MorphologyOptions& options) {
   switch (op) {
-    case Op::dilate: return dilate(a, b, options);
-    case Op::erode: return erode(a, b, options);
-    case Op::open: return open(a, b, options);
-    case Op::close: return close(a, b, options);
+    case Op::dilate:
+      return dilate(a, b, options);
+    case Op::erode:
+      return erode(a, b, options);
+    case Op::open:
+      return open(a, b, options);
+    case Op::close:
+      return close(a, b, options);
   }
   throw std::logic_error("unknown operation");
 }
 
 const char* empty_reason_name(EmptyReason reason) {
   switch (reason) {
-    case EmptyReason::none: return "none";
-    case EmptyReason::empty: return "empty";
-    case EmptyReason::flat: return "flat";
+    case EmptyReason::none:
+      return "none";
+    case EmptyReason::empty:
+      return "empty";
+    case EmptyReason::flat:
+      return "flat";
   }
   return "?";
 }
@@ -47,8 +55,8 @@ const char* empty_reason_name(EmptyReason reason) {
 std::string describe_mesh(const Mesh& mesh) {
   char volume[64];
   std::snprintf(volume, sizeof volume, "%.9g", mesh.n_faces() > 0 ? signed_volume(mesh) : 0.0);
-  return std::to_string(mesh.n_vertices()) + " vertices, " + std::to_string(mesh.n_edges()) + " edges, " +
-         std::to_string(mesh.n_faces()) + " facets, volume " + volume;
+  return std::to_string(mesh.n_vertices()) + " vertices, " + std::to_string(mesh.n_edges()) +
+         " edges, " + std::to_string(mesh.n_faces()) + " facets, volume " + volume;
 }
 
 // Warnings about options that cannot take effect, said once per process (not once per
@@ -67,14 +75,17 @@ std::optional<Failure> prepare_steps(const std::vector<PipelineStep>& steps, Rep
     const bool is_file = std::filesystem::is_regular_file(step.se_spec, ec);
     // Name the file when the element is one; else the place the spec came from.
     const std::string about =
-        is_file ? (step.where == "--se" ? step.se_spec : step.where + ": " + step.se_spec) : step.where;
+        is_file ? (step.where == "--se" ? step.se_spec : step.where + ": " + step.se_spec)
+                : step.where;
     Stage stage = is_file ? Stage::read : Stage::structuring_element;
     try {
       Mesh se = make_structuring_element(step.se_spec);
       stage = Stage::validate;
-      PreparedMesh checked = prepare_convex_polyhedron(se, is_file ? step.se_spec : "structuring element");
+      PreparedMesh checked =
+          prepare_convex_polyhedron(se, is_file ? step.se_spec : "structuring element");
       for (const std::string& note : checked.notes) reporter.note(about, note);
-      reporter.note(about, "structuring element '" + step.se_spec + "': " + describe_mesh(checked.mesh));
+      reporter.note(about,
+                    "structuring element '" + step.se_spec + "': " + describe_mesh(checked.mesh));
       prepared.push_back(PreparedStep{step, std::move(checked.mesh)});
     } catch (...) {
       return classify_current_exception(stage, about, reporter.program());
@@ -85,10 +96,14 @@ std::optional<Failure> prepare_steps(const std::vector<PipelineStep>& steps, Rep
 
 const char* status_name(JobStatus status) {
   switch (status) {
-    case JobStatus::ok: return "ok";
-    case JobStatus::empty: return "empty";
-    case JobStatus::failed: return "failed";
-    case JobStatus::skipped: return "skipped";
+    case JobStatus::ok:
+      return "ok";
+    case JobStatus::empty:
+      return "empty";
+    case JobStatus::failed:
+      return "failed";
+    case JobStatus::skipped:
+      return "skipped";
   }
   return "?";
 }
@@ -117,7 +132,8 @@ JobResult run_job(const Job& job, const JobSettings& settings, Reporter& reporte
     stage = Stage::read;
     about = name;
     Stopwatch watch;
-    const Mesh input = read_input(job.input, job.input == kStdStream ? settings.stdin_format : settings.input_format);
+    const Mesh input = read_input(
+        job.input, job.input == kStdStream ? settings.stdin_format : settings.input_format);
     stats.read_ms = watch.ms();
 
     stage = Stage::validate;
@@ -144,12 +160,14 @@ JobResult run_job(const Job& job, const JobSettings& settings, Reporter& reporte
       const std::string label = std::string(op_name(step.step.op)) + " " + step.step.se_spec;
       if (step_result.is_empty()) {
         empty_reason = step_result.empty_reason;
-        empty_message = step_result.message.empty() ? "the result has no interior" : step_result.message;
+        empty_message =
+            step_result.message.empty() ? "the result has no interior" : step_result.message;
         current = Mesh();
         origins.clear();
         has_origins = false;
         if (i + 1 < settings.steps.size()) {
-          reporter.note(name, "the result is empty after '" + label + "'; the remaining steps are skipped");
+          reporter.note(
+              name, "the result is empty after '" + label + "'; the remaining steps are skipped");
         }
         break;
       }
@@ -159,8 +177,9 @@ JobResult run_job(const Job& job, const JobSettings& settings, Reporter& reporte
       // erosion's facets carry no origin (MorphResult::origins is then empty).
       has_origins = !origins.empty();
       if (has_origins && origins.size() != current.n_faces()) {
-        throw std::logic_error("'" + label + "' returned " + std::to_string(origins.size()) + " facet origins for " +
-                               std::to_string(current.n_faces()) + " facets");
+        throw std::logic_error("'" + label + "' returned " + std::to_string(origins.size()) +
+                               " facet origins for " + std::to_string(current.n_faces()) +
+                               " facets");
       }
       char ms[32];
       std::snprintf(ms, sizeof ms, "%.3f", step_ms);
@@ -180,44 +199,51 @@ JobResult run_job(const Job& job, const JobSettings& settings, Reporter& reporte
         if (settings.stats) reporter.raw(stats_json(stats));
         return result;
       }
-      reporter.warning(name, result.message + (job.output.empty() ? "" : "; writing an empty mesh"));
+      reporter.warning(name,
+                       result.message + (job.output.empty() ? "" : "; writing an empty mesh"));
     }
 
     if (!job.output.empty()) {
       stage = Stage::write;
       about = output_name;
       WriteOptions write_options;
-      const bool binary_format = *output_format == MeshFormat::ply || *output_format == MeshFormat::stl;
+      const bool binary_format =
+          *output_format == MeshFormat::ply || *output_format == MeshFormat::stl;
       write_options.binary = settings.binary && binary_format;
       if (settings.binary && !binary_format) {
         std::call_once(g_warned_binary, [&] {
-          reporter.warning(output_name, std::string("--binary has no effect on ") + format_name(*output_format) +
+          reporter.warning(output_name, std::string("--binary has no effect on ") +
+                                            format_name(*output_format) +
                                             " (only PLY and STL have a binary variant)");
         });
       }
       if (settings.label_facets) {
-        const bool colour_format = *output_format == MeshFormat::ply || *output_format == MeshFormat::off;
+        const bool colour_format =
+            *output_format == MeshFormat::ply || *output_format == MeshFormat::off;
         if (!colour_format) {
           std::call_once(g_warned_labels_format, [&] {
-            reporter.warning(output_name, std::string("--label-facets: ") + format_name(*output_format) +
-                                              " has no face colours; write PLY or OFF to keep the labels");
+            reporter.warning(output_name,
+                             std::string("--label-facets: ") + format_name(*output_format) +
+                                 " has no face colours; write PLY or OFF to keep the labels");
           });
         } else if (has_origins) {
           write_options.face_colors = facet_colors(origins);
         } else if (!stats.empty) {
           std::call_once(g_warned_labels_erosion, [&] {
-            reporter.warning(output_name,
-                             "--label-facets: the result of an erosion or a closing (or of no operation) has "
-                             "no facet origins; no colours written");
+            reporter.warning(
+                output_name,
+                "--label-facets: the result of an erosion or a closing (or of no operation) has "
+                "no facet origins; no colours written");
           });
         }
       }
       watch.restart();
       write_output(current, job.output, *output_format, write_options);
       stats.write_ms = watch.ms();
-      reporter.note(name, "wrote " + output_name + " (" + format_name(*output_format) +
-                              (write_options.binary ? ", binary" : "") +
-                              (write_options.face_colors.empty() ? "" : ", facets coloured by origin") + ")");
+      reporter.note(
+          name, "wrote " + output_name + " (" + format_name(*output_format) +
+                    (write_options.binary ? ", binary" : "") +
+                    (write_options.face_colors.empty() ? "" : ", facets coloured by origin") + ")");
     }
     result.status = stats.empty ? JobStatus::empty : JobStatus::ok;
     result.exit_code = kExitOk;

@@ -2,14 +2,14 @@
 // write the result. Single-file apps run one job; a batch runs one per input file.
 #pragma once
 
-#include "cli.h"
-#include "pipeline.h"
-
 #include <morph/mesh.h>
 
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "cli.h"
+#include "pipeline.h"
 
 namespace morph::cli {
 
@@ -28,16 +28,16 @@ std::optional<Failure> prepare_steps(const std::vector<PipelineStep>& steps, Rep
 
 /// Everything about how to run jobs that does not depend on the input.
 struct JobSettings {
-  std::vector<PreparedStep> steps;           // empty: check and convert only
-  std::string op_label;                      // for --stats "op"
-  std::optional<MeshFormat> input_format;    // --input-format: read every input as this format
-  std::optional<MeshFormat> stdin_format;    // --input-format, else --format: the format of stdin
-  std::optional<MeshFormat> output_format;   // --format: overrides the output's extension
-  bool binary = false;                       // --binary (PLY, STL)
-  bool label_facets = false;                 // --label-facets
-  bool fail_on_empty = false;                // --fail-on-empty
-  bool stats = false;                        // --stats: print the JSON line
-  int threads = 1;                           // in effect (for stats; the cap is a ThreadLimit)
+  std::vector<PreparedStep> steps;          // empty: check and convert only
+  std::string op_label;                     // for --stats "op"
+  std::optional<MeshFormat> input_format;   // --input-format: read every input as this format
+  std::optional<MeshFormat> stdin_format;   // --input-format, else --format: the format of stdin
+  std::optional<MeshFormat> output_format;  // --format: overrides the output's extension
+  bool binary = false;                      // --binary (PLY, STL)
+  bool label_facets = false;                // --label-facets
+  bool fail_on_empty = false;               // --fail-on-empty
+  bool stats = false;                       // --stats: print the JSON line
+  int threads = 1;                          // in effect (for stats; the cap is a ThreadLimit)
 };
 
 /// One input and where its result goes ("" means nowhere, "-" is stdout).
@@ -52,7 +52,7 @@ const char* status_name(JobStatus status);
 
 struct JobResult {
   JobStatus status = JobStatus::failed;
-  int exit_code = kExitSoftware;  // 0, 4, or the failure's code
+  int exit_code = kExitSoftware;   // 0, 4, or the failure's code
   std::optional<Failure> failure;  // set when status is failed
   std::string message;             // why empty, or the failure on one line
   RunStats stats;

@@ -10,7 +10,8 @@
 
 namespace morph::cli {
 
-void add_common_options(po::options_description& output, po::options_description& general, CommonOptions& o) {
+void add_common_options(po::options_description& output, po::options_description& general,
+                        CommonOptions& o) {
   // clang-format off
   output.add_options()
     ("output,o", po::value(&o.output)->value_name("FILE"),
@@ -36,30 +37,36 @@ void add_common_options(po::options_description& output, po::options_description
 }
 
 void parse_command_line(int argc, const char* const argv[], const po::options_description& all,
-                        const po::positional_options_description& positional, po::variables_map& vm) {
-  po::store(po::command_line_parser(argc, argv)
-                .options(all)
-                .positional(positional)
-                .style(po::command_line_style::default_style & ~po::command_line_style::allow_guessing)
-                .run(),
-            vm);
+                        const po::positional_options_description& positional,
+                        po::variables_map& vm) {
+  po::store(
+      po::command_line_parser(argc, argv)
+          .options(all)
+          .positional(positional)
+          .style(po::command_line_style::default_style & ~po::command_line_style::allow_guessing)
+          .run(),
+      vm);
   po::notify(vm);
 }
 
-std::optional<Failure> apply_common_options(const CommonOptions& o, const ThreadLimit& threads, Reporter& reporter,
-                                            JobSettings& settings) {
+std::optional<Failure> apply_common_options(const CommonOptions& o, const ThreadLimit& threads,
+                                            Reporter& reporter, JobSettings& settings) {
   const std::string& program = reporter.program();
-  if (o.quiet && o.verbose) return make_failure(kExitUsage, "", "--quiet and --verbose exclude each other", program);
-  if (o.threads < 0) return make_failure(kExitUsage, "", "--threads must be 0 (all cores) or more", program);
+  if (o.quiet && o.verbose)
+    return make_failure(kExitUsage, "", "--quiet and --verbose exclude each other", program);
+  if (o.threads < 0)
+    return make_failure(kExitUsage, "", "--threads must be 0 (all cores) or more", program);
   try {
     if (!o.format.empty()) settings.output_format = format_from_name(o.format);
   } catch (const input_error&) {
-    return make_failure(kExitUsage, "", "--format '" + o.format + "' is not one of off, obj, ply, stl", program);
+    return make_failure(kExitUsage, "",
+                        "--format '" + o.format + "' is not one of off, obj, ply, stl", program);
   }
   try {
     if (!o.input_format.empty()) settings.input_format = format_from_name(o.input_format);
   } catch (const input_error&) {
-    return make_failure(kExitUsage, "", "--input-format '" + o.input_format + "' is not one of off, obj, ply, stl",
+    return make_failure(kExitUsage, "",
+                        "--input-format '" + o.input_format + "' is not one of off, obj, ply, stl",
                         program);
   }
   settings.stdin_format = settings.input_format ? settings.input_format : settings.output_format;
@@ -80,9 +87,11 @@ std::string se_grammar_help() {
 std::string label_palette_help() {
   return "Facet labels (--label-facets), fixed palette (RGB):\n"
          "  translated  0 114 178   blue    a facet of the input moved by a vertex of the element\n"
-         "  corner      230 159 0   orange  a facet of the element placed at a vertex of the input\n"
+         "  corner      230 159 0   orange  a facet of the element placed at a vertex of the "
+         "input\n"
          "  edge        0 158 115   green   a parallelogram: an input edge (+) an element edge\n"
-         "  (results of erode and close end with an erosion: no origins, written without colours)\n";
+         "  (results of erode and close end with an erosion: no origins, written without "
+         "colours)\n";
 }
 
 namespace {
@@ -95,34 +104,42 @@ struct OperationHelp {
 OperationHelp operation_help(Op op) {
   switch (op) {
     case Op::dilate:
-      return {"Dilates a convex polyhedron by a convex structuring element B:\n"
-              "  A (+) B = { a + b : a in A, b in B }   (the Minkowski sum; exact FIMS kernel)\n",
-              "sphere:r=0.05,level=2"};
+      return {
+          "Dilates a convex polyhedron by a convex structuring element B:\n"
+          "  A (+) B = { a + b : a in A, b in B }   (the Minkowski sum; exact FIMS kernel)\n",
+          "sphere:r=0.05,level=2"};
     case Op::erode:
-      return {"Erodes a convex polyhedron by a convex structuring element B:\n"
-              "  A (-) B = { x : x + B inside A }\n"
-              "When B fits nowhere inside A the result is empty: exit 0 with a warning and an empty\n"
-              "mesh written, or exit 4 and nothing written with --fail-on-empty.\n",
-              "cube:0.1"};
+      return {
+          "Erodes a convex polyhedron by a convex structuring element B:\n"
+          "  A (-) B = { x : x + B inside A }\n"
+          "When B fits nowhere inside A the result is empty: exit 0 with a warning and an empty\n"
+          "mesh written, or exit 4 and nothing written with --fail-on-empty.\n",
+          "cube:0.1"};
     case Op::open:
-      return {"Opens a convex polyhedron by a convex structuring element B:\n"
-              "  (A (-) B) (+) B   the union of the translates of B inside A (rounds edges and corners)\n"
-              "An empty erosion gives an empty result (exit 0 with a warning; 4 with --fail-on-empty).\n",
-              "sphere:r=0.05,level=2"};
+      return {
+          "Opens a convex polyhedron by a convex structuring element B:\n"
+          "  (A (-) B) (+) B   the union of the translates of B inside A (rounds edges and "
+          "corners)\n"
+          "An empty erosion gives an empty result (exit 0 with a warning; 4 with "
+          "--fail-on-empty).\n",
+          "sphere:r=0.05,level=2"};
     case Op::close:
-      return {"Closes a convex polyhedron by a convex structuring element B:\n"
-              "  (A (+) B) (-) B   (for a convex input this is the input itself)\n",
-              "box:0.1,0.1,0.1"};
+      return {
+          "Closes a convex polyhedron by a convex structuring element B:\n"
+          "  (A (+) B) (-) B   (for a convex input this is the input itself)\n",
+          "box:0.1,0.1,0.1"};
   }
   return {"", ""};
 }
 
-std::string operation_usage(const std::string& program, Op op, const po::options_description& visible) {
+std::string operation_usage(const std::string& program, Op op,
+                            const po::options_description& visible) {
   const OperationHelp help = operation_help(op);
   const std::string se = help.example_se;
   std::ostringstream out;
   out << "Usage: " << program << " INPUT --se SPEC -o OUTPUT [options]\n\n"
-      << help.summary << "\nINPUT is a mesh file (.off .obj .ply .stl) or '-' for stdin (with --input-format).\n"
+      << help.summary
+      << "\nINPUT is a mesh file (.off .obj .ply .stl) or '-' for stdin (with --input-format).\n"
       << "It must be a closed convex polyhedron; an inverted one is flipped (a note with -v).\n"
       << visible << "\n"
       << se_grammar_help() << "\n"
@@ -146,8 +163,9 @@ int run_operation_app(int argc, const char* const argv[], Op op) {
     std::string input;
     std::string se;
     po::options_description operation("Operation");
-    operation.add_options()("se", po::value(&se)->value_name("SPEC"),
-                            "structuring element: a parametric spec or a convex mesh file (grammar below)");
+    operation.add_options()(
+        "se", po::value(&se)->value_name("SPEC"),
+        "structuring element: a parametric spec or a convex mesh file (grammar below)");
     po::options_description output("Output");
     po::options_description general("General");
     add_common_options(output, general, common);
@@ -178,26 +196,31 @@ int run_operation_app(int argc, const char* const argv[], Op op) {
     reporter.set_quiet(common.quiet);
     reporter.set_verbose(common.verbose);
     if (input.empty()) {
-      report(reporter, make_failure(kExitUsage, "", "missing INPUT (a mesh file, or '-' for stdin)", program));
+      report(reporter, make_failure(kExitUsage, "", "missing INPUT (a mesh file, or '-' for stdin)",
+                                    program));
       return kExitUsage;
     }
     if (se.empty()) {
-      report(reporter, make_failure(kExitUsage, "", "missing --se SPEC (the structuring element)", program));
+      report(reporter,
+             make_failure(kExitUsage, "", "missing --se SPEC (the structuring element)", program));
       return kExitUsage;
     }
     if (common.output.empty()) {
-      report(reporter, make_failure(kExitUsage, "", "missing -o OUTPUT (a mesh file, or '-' for stdout)", program));
+      report(reporter, make_failure(kExitUsage, "",
+                                    "missing -o OUTPUT (a mesh file, or '-' for stdout)", program));
       return kExitUsage;
     }
 
     const ThreadLimit threads(common.threads);
     JobSettings settings;
-    if (std::optional<Failure> failure = apply_common_options(common, threads, reporter, settings)) {
+    if (std::optional<Failure> failure =
+            apply_common_options(common, threads, reporter, settings)) {
       report(reporter, *failure);
       return failure->code;
     }
     settings.op_label = op_name(op);
-    if (std::optional<Failure> failure = prepare_steps({PipelineStep{op, se, "--se"}}, reporter, settings.steps)) {
+    if (std::optional<Failure> failure =
+            prepare_steps({PipelineStep{op, se, "--se"}}, reporter, settings.steps)) {
       report(reporter, *failure);
       return failure->code;
     }

@@ -1,15 +1,14 @@
 // Command-line options shared by the apps, on Boost.Program_options.
 #pragma once
 
-#include "cli.h"
-#include "job.h"
-#include "pipeline.h"
-
 #include <boost/program_options.hpp>
-
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "cli.h"
+#include "job.h"
+#include "pipeline.h"
 
 namespace morph::cli {
 
@@ -33,16 +32,19 @@ struct CommonOptions {
 
 /// Adds -o, --format, --input-format, --binary, --label-facets, --fail-on-empty and
 /// --threads to `output`, and --stats, -q, -v, --help, --version to `general`.
-void add_common_options(po::options_description& output, po::options_description& general, CommonOptions& options);
+void add_common_options(po::options_description& output, po::options_description& general,
+                        CommonOptions& options);
 
 /// Parses the command line into `vm` and notifies. Throws po::error on bad options.
 void parse_command_line(int argc, const char* const argv[], const po::options_description& all,
-                        const po::positional_options_description& positional, po::variables_map& vm);
+                        const po::positional_options_description& positional,
+                        po::variables_map& vm);
 
 /// Checks the common options and fills the input-independent part of `settings`
 /// (formats, flags, thread count). Returns a usage failure for bad values.
-std::optional<Failure> apply_common_options(const CommonOptions& options, const ThreadLimit& threads,
-                                            Reporter& reporter, JobSettings& settings);
+std::optional<Failure> apply_common_options(const CommonOptions& options,
+                                            const ThreadLimit& threads, Reporter& reporter,
+                                            JobSettings& settings);
 
 /// The help text sections shared by the apps: structuring-element grammar, palette,
 /// exit codes.

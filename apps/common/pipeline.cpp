@@ -42,10 +42,14 @@ std::string excerpt(std::string_view s) {
 
 const char* op_name(Op op) {
   switch (op) {
-    case Op::dilate: return "dilate";
-    case Op::erode: return "erode";
-    case Op::open: return "open";
-    case Op::close: return "close";
+    case Op::dilate:
+      return "dilate";
+    case Op::erode:
+      return "erode";
+    case Op::open:
+      return "open";
+    case Op::close:
+      return "close";
   }
   return "?";
 }
@@ -64,7 +68,9 @@ PipelineStep parse_step(std::string_view text, std::string_view where) {
   const std::string_view word = step.substr(0, end);
   const std::string_view spec = trim(step.substr(end));
   if (word.empty()) {
-    throw input_error(std::string(where) + ": empty step (expected '<op> <spec>', op one of dilate, erode, open, close)");
+    throw input_error(
+        std::string(where) +
+        ": empty step (expected '<op> <spec>', op one of dilate, erode, open, close)");
   }
   const std::optional<Op> op = op_from_name(word);
   if (!op) {
@@ -73,7 +79,8 @@ PipelineStep parse_step(std::string_view text, std::string_view where) {
   }
   if (spec.empty()) {
     throw input_error(std::string(where) + ": '" + std::string(word) +
-                      "' needs a structuring element (e.g. '" + std::string(word) + " sphere:r=0.1')");
+                      "' needs a structuring element (e.g. '" + std::string(word) +
+                      " sphere:r=0.1')");
   }
   return PipelineStep{*op, std::string(spec), std::string(where)};
 }
@@ -88,7 +95,8 @@ std::vector<PipelineStep> parse_pipeline(std::string_view text, std::string_view
     text = newline == std::string_view::npos ? std::string_view{} : text.substr(newline + 1);
     const std::string where = std::string(source) + ":" + std::to_string(line_number);
     if (line.size() > kMaxPipelineLineLength) {
-      throw input_error(where + ": line longer than " + std::to_string(kMaxPipelineLineLength) + " bytes");
+      throw input_error(where + ": line longer than " + std::to_string(kMaxPipelineLineLength) +
+                        " bytes");
     }
     if (line.find('\0') != std::string_view::npos) {
       throw input_error(where + ": NUL byte (a pipeline file is text)");
@@ -101,8 +109,9 @@ std::vector<PipelineStep> parse_pipeline(std::string_view text, std::string_view
     steps.push_back(parse_step(content, where));
   }
   if (steps.empty()) {
-    throw input_error(std::string(source) + ":" + std::to_string(line_number > 0 ? line_number : 1) +
-                      ": no step in the pipeline (expected lines '<op> <spec>', e.g. 'open sphere:r=0.1')");
+    throw input_error(
+        std::string(source) + ":" + std::to_string(line_number > 0 ? line_number : 1) +
+        ": no step in the pipeline (expected lines '<op> <spec>', e.g. 'open sphere:r=0.1')");
   }
   return steps;
 }
