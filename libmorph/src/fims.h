@@ -45,9 +45,10 @@ Polytope sum_polytope(const Polytope& A, const Polytope& B, const SumFacets& fac
 /// noise of floating-point input (about 1e-15 relative).
 inline constexpr double kFeatureTolerance = 1e-11;
 
-/// Builds a mesh from rounded points and facet cycles, collapsing edges shorter than
-/// kFeatureTolerance times the diagonal (each cluster keeps its lowest-index vertex) and
-/// dropping facets that degenerate; `keep` (optional, one per facet) receives whether
+/// Builds a mesh from rounded points and facet cycles, merging corners of a facet closer
+/// than kFeatureTolerance times the diagonal (short edges, and the short diagonal of a
+/// thin parallelogram; each cluster keeps its lowest-index vertex) and dropping facets
+/// that degenerate; `keep` (optional, one per facet) receives whether
 /// each facet survived.
 Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& face_begin,
                 const std::vector<int>& corners, std::vector<char>* keep);

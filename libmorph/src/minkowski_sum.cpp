@@ -245,6 +245,7 @@ Polytope sum_polytope(const Polytope& A, const Polytope& B, const SumFacets& fac
 
 Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& face_begin,
                 const std::vector<int>& corners, std::vector<char>* keep) {
+  constexpr int kPairwiseDegree = 16;  // facets up to this degree are checked corner by corner
   const int n = static_cast<int>(points.size());
   const int nf = static_cast<int>(face_begin.size()) - 1;
   // Edges shorter than kFeatureTolerance times the diagonal are collapsed; each cluster
@@ -263,14 +264,20 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
     while (rep[x] != x) x = rep[x] = rep[rep[x]];
     return x;
   };
+  auto merge_if_close = [&](int u, int w) {
+    const V3<double> d = points[u] - points[w];
+    if (std::sqrt(dot(d, d)) <= limit) {
+      const int a = find(u), b = find(w);
+      if (a != b) rep[std::max(a, b)] = std::min(a, b);
+    }
+  };
   for (int f = 0; f < nf; ++f) {
-    for (int c = face_begin[f]; c < face_begin[f + 1]; ++c) {
-      const int u = corners[c], w = corners[c + 1 == face_begin[f + 1] ? face_begin[f] : c + 1];
-      const V3<double> d = points[u] - points[w];
-      if (std::sqrt(dot(d, d)) <= limit) {
-        const int a = find(u), b = find(w);
-        if (a != b) rep[std::max(a, b)] = std::min(a, b);
-      }
+    const int b = face_begin[f], e = face_begin[f + 1];
+    if (e - b <= kPairwiseDegree) {  // also across a facet: the diagonal of a thin parallelogram
+      for (int c = b; c < e; ++c)
+        for (int d = c + 1; d < e; ++d) merge_if_close(corners[c], corners[d]);
+    } else {
+      for (int c = b; c < e; ++c) merge_if_close(corners[c], corners[c + 1 == e ? b : c + 1]);
     }
   }
   Mesh mesh;
@@ -285,7 +292,10 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
       if (cyc.empty() || cyc.back() != v) cyc.push_back(v);
     }
     while (cyc.size() > 1 && cyc.front() == cyc.back()) cyc.pop_back();
-    if (cyc.size() < 3) {
+    // A facet that still visits a vertex twice has collapsed onto a path: no area left.
+    std::vector<int> sorted = cyc;
+    std::sort(sorted.begin(), sorted.end());
+    if (cyc.size() < 3 || std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
       cyc.clear();
       continue;
     }
