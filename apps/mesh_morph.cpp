@@ -258,6 +258,15 @@ int run(int argc, const char* const argv[], Reporter& reporter) {
     }
     jobs.push_back(std::move(job));
   }
+  if (!report_file.empty()) {
+    const fs::path parent =
+        fs::path(report_file).has_parent_path() ? fs::path(report_file).parent_path() : ".";
+    std::error_code ec;
+    if (!fs::is_directory(parent, ec)) {
+      return fail(reporter, make_failure(kExitCantCreate, report_file,
+                                         "the report's directory does not exist", kProgram));
+    }
+  }
   if (!output_dir.empty()) {
     std::error_code ec;
     fs::create_directories(output_dir, ec);
@@ -269,15 +278,6 @@ int run(int argc, const char* const argv[], Reporter& reporter) {
     }
   } else if (!steps.empty()) {
     reporter.warning("", "no --output-dir given: the results are computed but not written");
-  }
-  if (!report_file.empty()) {
-    const fs::path parent =
-        fs::path(report_file).has_parent_path() ? fs::path(report_file).parent_path() : ".";
-    std::error_code ec;
-    if (!fs::is_directory(parent, ec)) {
-      return fail(reporter, make_failure(kExitCantCreate, report_file,
-                                         "the report's directory does not exist", kProgram));
-    }
   }
   if (std::optional<Failure> failure = prepare_steps(steps, reporter, settings.steps))
     return fail(reporter, *failure);

@@ -176,6 +176,9 @@ Failure classify_current_exception(Stage stage, std::string_view file, std::stri
     what = what.substr(0, what.find('\n'));
   }
   Failure failure = make_failure(code, file, what, program);
+  if (code == kExitCantCreate && file == "<stdout>") {
+    failure.hint = "Check that standard output is writable (a closed pipe, a full disk)";
+  }
   if (stage == Stage::structuring_element && code == kExitUsage) {
     failure.hint = "Run '" + std::string(program) + " --help' for the structuring-element grammar";
   }
