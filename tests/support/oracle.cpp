@@ -72,6 +72,11 @@ Position rounded(const EPoint& p) {
 
 Position position(const Point& p) { return {p[0], p[1], p[2]}; }
 
+bool representable(const EPoint& p) {
+  const Position r = rounded(p);
+  return Q(r[0]) == CGAL::exact(p.x()) && Q(r[1]) == CGAL::exact(p.y()) && Q(r[2]) == CGAL::exact(p.z());
+}
+
 // The plane of a polygon by Newell's normal through its centroid; zero normal when the
 // polygon has no area.
 Plane newell_plane(const std::vector<Point>& p) {
@@ -235,6 +240,7 @@ Description describe_hull(const ExactHull& hull) {
   d.facet_count = d.facets.size();
   d.edge_count = degrees / 2;
   d.volume = round_nearest(hull.volume);
+  d.exact_positions = std::all_of(hull.points.begin(), hull.points.end(), representable);
   return d;
 }
 
@@ -357,7 +363,16 @@ Description describe(const Mesh& mesh) {
     std::vector<Point> p;
     for (auto v : mesh.fv_range(f)) p.push_back(mesh.point(v));
     for (std::size_t i = 1; i + 1 < p.size(); ++i) volume += OpenMesh::dot(p[0], OpenMesh::cross(p[i], p[i + 1]));
-    const Plane plane = newell_plane(p);
+    Plane plane = newell_plane(p);
+    {
+      // Newell's vector is twice the area; below ~1e-12 of the face's extent squared its
+      // direction is rounding noise (a degenerate face, reported by the clean check).
+      Point lo = p[0], hi = p[0];
+      for (const Point& q : p) lo.minimize(q), hi.maximize(q);
+      Point n(0, 0, 0);
+      for (std::size_t i = 0; i < p.size(); ++i) n += OpenMesh::cross(p[i], p[(i + 1) % p.size()]);
+      plane.reliable = n.norm() > 1e-12 * (hi - lo).sqrnorm();
+    }
     std::vector<Position> facet;
     for (const Point& q : p) facet.push_back(position(q));
     std::sort(facet.begin(), facet.end());
@@ -519,7 +534,7 @@ bool volume_close(double got, double want, double rel) {
 double excess(const Position& v, const std::vector<Plane>& planes) {
   double worst = -std::numeric_limits<double>::infinity();
   for (const Plane& h : planes) {
-    worst = std::max(worst, h.normal[0] * v[0] + h.normal[1] * v[1] + h.normal[2] * v[2] - h.offset);
+    if (h.reliable) worst = std::max(worst, h.normal[0] * v[0] + h.normal[1] * v[1] + h.normal[2] * v[2] - h.offset);
   }
   return worst;
 }
@@ -704,13 +719,9 @@ std::string clean_mesh_problem(const Mesh& mesh, const CleanOptions& options) {
     return signed_distance(plane[f.idx()], mesh.point(v)) > tol;
   };
   auto coplanar_faces = [&](Mesh::FaceHandle f, Mesh::FaceHandle g) {
+    const auto& t = triple[f.idx()];
     for (auto v : mesh.fv_range(g)) {
-      if (options.exact) {
-        const auto& t = triple[f.idx()];
-        if (!CGAL::coplanar(t[0], t[1], t[2], ipoint(v))) return false;
-      } else {
-        if (std::abs(signed_distance(plane[f.idx()], mesh.point(v))) > tol) return false;
-      }
+      if (!CGAL::coplanar(t[0], t[1], t[2], ipoint(v))) return false;
     }
     return true;
   };
@@ -719,7 +730,12 @@ std::string clean_mesh_problem(const Mesh& mesh, const CleanOptions& options) {
       if (above(f, v)) return "not convex: vertex " + std::to_string(v.idx()) + " above face " + std::to_string(f.idx());
     }
   }
-  if (!options.minimal) return {};
+  if (!options.exact) {
+    for (auto v : mesh.vertices()) {
+      if (mesh.valence(v) < 3) return "not minimal: vertex " + std::to_string(v.idx()) + " has fewer than 3 faces";
+    }
+    return {};
+  }
   for (auto e : mesh.edges()) {
     const auto f = mesh.face_handle(mesh.halfedge_handle(e, 0));
     const auto g = mesh.face_handle(mesh.halfedge_handle(e, 1));
@@ -740,16 +756,9 @@ std::string clean_mesh_problem(const Mesh& mesh, const CleanOptions& options) {
   return {};
 }
 
-CleanOptions clean_options_for(const Mesh& result, const std::vector<const Mesh*>& operands) {
+CleanOptions clean_options_for(const Description& exact_reference) {
   CleanOptions options;
-  if (exactly_planar(result)) return options;
-  options.exact = false;
-  for (const Mesh* m : operands) {
-    CleanOptions probe;
-    probe.exact = false;
-    const std::string problem = clean_mesh_problem(*m, probe);
-    if (problem.find("not minimal") != std::string::npos) options.minimal = false;
-  }
+  options.exact = exact_reference.exact_positions;
   return options;
 }
 

@@ -24,6 +24,7 @@ using Position = std::array<double, 3>;
 struct Plane {
   Position normal{};
   double offset = 0.0;
+  bool reliable = true;  // false for a (nearly) zero-area face: its direction is noise
 };
 
 /// A convex polyhedron described independently of its mesh data structure.
@@ -35,6 +36,7 @@ struct Description {
   std::size_t edge_count = 0;  // half the sum of facet degrees
   std::size_t facet_count = 0;
   double volume = 0.0;
+  bool exact_positions = false;  // oracle only: every vertex coordinate is a double exactly
   std::vector<std::size_t> facet_degrees() const;  // sorted
 };
 
@@ -84,26 +86,30 @@ bool exactly_planar(const Mesh& mesh);
 
 /// Options of the clean-mesh check.
 struct CleanOptions {
-  /// true: planarity, convexity, coplanarity of neighbours decided exactly;
-  /// false: to `tolerance` times the bounding-box diagonal (rounded or bent facets).
+  /// true: for meshes whose coordinates are exact (integer or grid operands): planarity,
+  /// convexity and minimality (no coplanar neighbours, >= 3 face planes at every vertex)
+  /// decided exactly.
+  /// false: for vertices rounded from exact values: planarity and convexity to
+  /// `tolerance` times the bounding-box diagonal; minimality only as "every vertex has
+  /// >= 3 faces". Rounding can make nearly coplanar neighbours (legitimate where operands
+  /// are nearly degenerate, e.g. a triangulated rotated cube) exactly coplanar, so
+  /// minimality of rounded results is decided by comparing facets with the exact oracle.
   bool exact = true;
   double tolerance = 1e-9;  // the library's own acceptance (kPlanarityTolerance)
-  /// Check minimality (no coplanar neighbours, >= 3 planes at every vertex).
-  bool minimal = true;
 };
 
 /// The first violation of "clean convex mesh", or empty: closed, 2-manifold, connected,
 /// Euler characteristic 2, outward (positive volume), faces with >= 3 distinct vertices
-/// and non-zero area, planar, convex, no two adjacent faces coplanar, every vertex has
-/// >= 3 distinct face planes around it, no duplicate vertex positions.
+/// and non-zero area, planar, convex, minimal (see CleanOptions), no duplicate vertex
+/// positions.
 std::string clean_mesh_problem(const Mesh& mesh, const CleanOptions& options = {});
 
-/// The strictest fair check of a computed result: exact when its faces are exactly
-/// planar; else (rounded vertices) to the tolerance, with minimality checked to the
-/// tolerance only when no operand has neighbours coplanar within it (an operand such as
-/// a triangulated rotated cube legitimately yields facets meeting at 1e-16 angles, and
-/// the exact oracle comparisons already decide minimality).
-CleanOptions clean_options_for(const Mesh& result, const std::vector<const Mesh*>& operands);
+/// The strictest fair check of a result whose exact reference is known: exact when the
+/// reference's vertices are all exactly doubles, else to the tolerance.
+CleanOptions clean_options_for(const Description& exact_reference);
+
+/// For rounded results without an exact reference.
+inline constexpr CleanOptions kRoundedClean{.exact = false};
 
 /// The diagonal of the bounding box.
 double bbox_diagonal(const Mesh& mesh);
