@@ -29,16 +29,19 @@ int main() {
 
   // Dilation: the box grows by 0.5 in each direction; its 6 facets are translated facets.
   const morph::MorphResult d = morph::dilate(a, b, options);
-  check(d.mesh.n_vertices() == 8 && d.mesh.n_faces() == 6, "dilation is a box (8 vertices, 6 facets)");
+  check(d.mesh.n_vertices() == 8 && d.mesh.n_faces() == 6,
+        "dilation is a box (8 vertices, 6 facets)");
   check(near(morph::signed_volume(d.mesh), 1.5 * 2.5 * 3.5), "dilation volume 1.5 * 2.5 * 3.5");
   check(d.origins.size() == d.mesh.n_faces(), "one facet origin per facet");
   bool translated = true;
-  for (const morph::FacetOrigin& o : d.origins) translated = translated && o.kind == morph::FacetKind::translated;
+  for (const morph::FacetOrigin& o : d.origins)
+    translated = translated && o.kind == morph::FacetKind::translated;
   check(translated, "every facet of a box (+) box is a translated facet");
 
   // Erosion: the box shrinks by 0.5 in each direction.
   const morph::MorphResult e = morph::erode(a, b, options);
-  check(!e.is_empty() && near(morph::signed_volume(e.mesh), 0.5 * 1.5 * 2.5), "erosion volume 0.5 * 1.5 * 2.5");
+  check(!e.is_empty() && near(morph::signed_volume(e.mesh), 0.5 * 1.5 * 2.5),
+        "erosion volume 0.5 * 1.5 * 2.5");
 
   // Opening a box by a smaller box gives the box back.
   const morph::MorphResult o = morph::open(a, b, options);
@@ -46,7 +49,8 @@ int main() {
 
   // An element that does not fit: the erosion is empty, not an error.
   const morph::MorphResult none = morph::erode(b, a, options);
-  check(none.empty_reason == morph::EmptyReason::empty, "eroding the small box by the big one is empty");
+  check(none.empty_reason == morph::EmptyReason::empty,
+        "eroding the small box by the big one is empty");
 
   // Errors are typed: an open mesh (one facet removed) is an invalid_mesh, a morph::error.
   morph::Mesh open_box = a;
@@ -56,9 +60,11 @@ int main() {
     morph::dilate(open_box, b);
     check(false, "an open mesh is rejected");
   } catch (const morph::invalid_mesh& err) {
-    check(std::string(err.what()).find("A") != std::string::npos, std::string("invalid_mesh: ") + err.what());
+    check(std::string(err.what()).find("A") != std::string::npos,
+          std::string("invalid_mesh: ") + err.what());
   }
 
-  std::printf("libmorph %s: %s\n", morph::kVersion, failures == 0 ? "all checks passed" : "checks failed");
+  std::printf("libmorph %s: %s\n", morph::kVersion,
+              failures == 0 ? "all checks passed" : "checks failed");
   return failures == 0 ? 0 : 1;
 }
