@@ -9,6 +9,9 @@
 //   --markdown FILE              also write the report (Markdown tables) to FILE
 //   --samples DIR                where the sample meshes are (default: the source tree's samples/)
 //   --budget SECONDS             time aimed at per measurement, repetitions included (default 1)
+//   --filter TEXT                Table 1 and morphology: only the pairs whose "A + B" contains TEXT
+//   --loop A B SECONDS [THREADS] only A (+) B with libmorph, repeated for SECONDS (for perf record);
+//                                A and B are sample files, B = "rotated" is A turned as in Table 1
 //
 // Every measurement runs once as a warm-up (not counted), then repeats as many times as
 // fit in the budget (3 to 15 times) and reports the median. The hull route is what a user
@@ -67,6 +70,7 @@ struct Settings {
   std::filesystem::path samples = MORPH_SAMPLES_DIR;
   std::filesystem::path csv_dir;  // empty: no CSV
   std::filesystem::path markdown;  // empty: no file
+  std::string filter;              // Table 1 / morphology pairs whose "A + B" contains it
   double budget_seconds = 1.0;
   int min_reps = 3;
   int max_reps = 15;
@@ -303,14 +307,18 @@ std::vector<Pair> table1_pairs(const Settings& settings) {
   auto s = [&](const char* file) { return sample(settings, file); };
   Operand ico5120 = s("icosphere_5120.off");
   Operand ico5120_rotated{"icosphere_5120.off rotated", rotated(ico5120.mesh, kRotationAngle)};
-  return {{s("hedra.off"), s("icosphere_320.off")},
-          {s("hedra.off"), s("icosphere_1280.off")},
-          {s("cube.off"), s("icosphere_320.off")},
-          {s("cube.off"), s("icosphere_1280.off")},
-          {s("icosphere_80.off"), s("icosphere_320.off")},
-          {s("icosphere_320.off"), s("icosphere_1280.off")},
-          {s("uvsphere_1600.off"), s("snub_dodecahedron.off")},
-          {ico5120, ico5120_rotated}};
+  std::vector<Pair> pairs{{s("hedra.off"), s("icosphere_320.off")},
+                          {s("hedra.off"), s("icosphere_1280.off")},
+                          {s("cube.off"), s("icosphere_320.off")},
+                          {s("cube.off"), s("icosphere_1280.off")},
+                          {s("icosphere_80.off"), s("icosphere_320.off")},
+                          {s("icosphere_320.off"), s("icosphere_1280.off")},
+                          {s("uvsphere_1600.off"), s("snub_dodecahedron.off")},
+                          {ico5120, ico5120_rotated}};
+  std::erase_if(pairs, [&](const Pair& p) {
+    return (p.a.name + " + " + p.b.name).find(settings.filter) == std::string::npos;
+  });
+  return pairs;
 }
 
 std::string operand_cell(const Operand& op) {
@@ -459,6 +467,20 @@ std::string peak_memory(const std::string& series, int parameter) {
   return fixed(after / 1024.0, 0) + " MiB peak resident (operands alone: " + fixed(before / 1024.0, 0) + " MiB)";
 }
 
+// Repeats one libmorph sum for a while, for a profiler to sample.
+int run_loop(const Settings& settings, const std::string& a_file, const std::string& b_file, double seconds,
+             int threads) {
+  const Mesh a = morph::read_mesh(settings.samples / a_file);
+  const Mesh b = b_file == "rotated" ? rotated(a, kRotationAngle) : morph::read_mesh(settings.samples / b_file);
+  const auto start = Clock::now();
+  int runs = 0;
+  Counts out;
+  while (milliseconds_since(start) < seconds * 1000.0) out = libmorph_sum(a, b, threads), ++runs;
+  std::printf("%d runs, %.3f ms each, %zu vertices, %zu facets\n", runs, milliseconds_since(start) / runs,
+              out.vertices, out.facets);
+  return 0;
+}
+
 int run_peak_case(const std::string& series, int parameter) {
   const ScalingCase c = make_case(series, parameter);
   const long before = peak_rss_kib();
@@ -533,6 +555,8 @@ std::string machine() {
 void usage(std::ostream& out) {
   out << "usage: morph-bench [--table1] [--morphology] [--scaling] [--all]\n"
          "                   [--csv DIR] [--markdown FILE] [--samples DIR] [--budget SECONDS]\n"
+         "                   [--filter TEXT]\n"
+         "       morph-bench [--samples DIR] --loop A.off B.off|rotated SECONDS [THREADS]\n"
          "  no selection: Table 1, morphology and a quick scaling run\n";
 }
 
@@ -557,6 +581,13 @@ int main(int argc, char** argv) {
       else if (arg == "--markdown") settings.markdown = value();
       else if (arg == "--samples") settings.samples = value();
       else if (arg == "--budget") settings.budget_seconds = std::stod(value());
+      else if (arg == "--filter") settings.filter = value();
+      else if (arg == "--loop") {
+        const std::string a = value(), b = value();
+        const double seconds = std::stod(value());
+        const int threads = i + 1 < args.size() && args[i + 1][0] != '-' ? std::stoi(value()) : 1;
+        return run_loop(settings, a, b, seconds, threads);
+      }
       else if (arg == "--help" || arg == "-h") return usage(std::cout), 0;
       else throw std::runtime_error("unknown option " + arg);
     }
