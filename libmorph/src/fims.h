@@ -45,12 +45,14 @@ Polytope sum_polytope(const Polytope& A, const Polytope& B, const SumFacets& fac
 /// noise of floating-point input (about 1e-15 relative).
 inline constexpr double kFeatureTolerance = 1e-11;
 
-/// Builds a mesh from rounded points and facet cycles, merging corners of a facet closer
-/// than kFeatureTolerance times the diagonal (short edges, and the short diagonal of a
-/// thin parallelogram; each cluster keeps its lowest-index vertex) and dropping facets
-/// that degenerate; `keep` (optional, one per facet) receives whether
-/// each facet survived.
+/// Builds the output mesh from rounded points and facet cycles of an exact result.
+/// Corners of a facet closer than kFeatureTolerance times the diagonal are merged (each
+/// cluster keeps its lowest-index vertex). When nothing merges, the facets are used as
+/// they are. Otherwise the mesh is rebuilt as the exact convex hull of the merged points,
+/// its triangles grouped back into the result's facets (a triangle belongs to the facet
+/// all three of its corners came from): closed and convex by construction, facets kept
+/// as polygons. `source` (optional) receives, per output face, its facet index.
 Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& face_begin,
-                const std::vector<int>& corners, std::vector<char>* keep);
+                const std::vector<int>& corners, std::vector<int>* source);
 
 }  // namespace morph::detail

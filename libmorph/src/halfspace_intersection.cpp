@@ -13,7 +13,9 @@
 #include <CGAL/convex_hull_3.h>
 
 #include <algorithm>
+#include <atomic>
 #include <map>
+#include <numeric>
 
 #include "gauss_map.h"
 #include "parallel.h"
@@ -60,7 +62,7 @@ CentreResult exact_centre(const std::vector<HalfSpace>& hs) {
 /// o strictly inside every half-space? (interval filter, exact when undecided)
 bool strictly_inside(const std::vector<HalfSpace>& hs, const V3<Exact>& o) {
   const V3<Interval> oi = to_interval(o);
-  bool inside = true;
+  std::atomic<bool> inside = true;
   parallel_chunks(static_cast<int>(hs.size()), 512, [&](int begin, int end) {
     RoundingGuard guard;
     for (int i = begin; i < end && inside; ++i) {
@@ -163,6 +165,43 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
     face_source.push_back(hs[face_halfspace.back()].source);
   }
   if (faces.empty()) throw error("internal error: an intersection of half-spaces has no facets");
+  // Number vertices and facets canonically (CGAL's hull order depends on its internal
+  // shuffling): a vertex by the sorted half-spaces through it, a facet by its half-space,
+  // each cycle starting at its smallest vertex. The output then depends only on the input.
+  {
+    std::vector<std::vector<int>> key(groups.size());
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      for (auto f : groups[g])
+        for (auto v : CGAL::vertices_around_face(hull.halfedge(f), hull)) key[g].push_back(index_of.at(hull.point(v)));
+      std::sort(key[g].begin(), key[g].end());
+      key[g].erase(std::unique(key[g].begin(), key[g].end()), key[g].end());
+    }
+    std::vector<int> order(groups.size()), rank(groups.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return key[a] < key[b]; });
+    std::vector<V3<Exact>> sorted_vertex(groups.size());
+    for (std::size_t r = 0; r < order.size(); ++r) {
+      rank[order[r]] = static_cast<int>(r);
+      sorted_vertex[r] = vertex[order[r]];
+    }
+    vertex = std::move(sorted_vertex);
+    std::vector<int> forder(faces.size());
+    std::iota(forder.begin(), forder.end(), 0);
+    std::sort(forder.begin(), forder.end(), [&](int a, int b) { return face_halfspace[a] < face_halfspace[b]; });
+    std::vector<std::vector<int>> sorted_faces;
+    std::vector<int> sorted_source, sorted_halfspace;
+    for (int f : forder) {
+      auto cyc = faces[f];
+      for (int& g : cyc) g = rank[g];
+      std::rotate(cyc.begin(), std::min_element(cyc.begin(), cyc.end()), cyc.end());
+      sorted_faces.push_back(std::move(cyc));
+      sorted_source.push_back(face_source[f]);
+      sorted_halfspace.push_back(face_halfspace[f]);
+    }
+    faces = std::move(sorted_faces);
+    face_source = std::move(sorted_source);
+    face_halfspace = std::move(sorted_halfspace);
+  }
   // Circulating around a hull vertex may run clockwise: orient by the first facet.
   {
     const auto& cyc = faces[0];

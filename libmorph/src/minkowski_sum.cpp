@@ -208,11 +208,11 @@ LabelledMesh sum_mesh(const Polytope& A, const Polytope& B, const SumFacets& fac
       }
     }
   });
-  std::vector<char> keep;
+  std::vector<int> source;
   LabelledMesh out;
-  out.mesh = clean_mesh(points, facets.face_begin, corners, &keep);
-  for (int f = 0; f < facets.num_faces(); ++f)
-    if (keep[f]) out.origins.push_back(facets.origins[f]);
+  out.mesh = clean_mesh(points, facets.face_begin, corners, &source);
+  // A face with no source (a triangle of the hull fallback that no facet owns) has no origin.
+  for (int f : source) out.origins.push_back(f >= 0 ? facets.origins[f] : FacetOrigin{FacetKind::edge, {}, {}});
   return out;
 }
 
@@ -241,80 +241,6 @@ Polytope sum_polytope(const Polytope& A, const Polytope& B, const SumFacets& fac
                                        [&](int i) -> const V3<ExactN>& { return cycle[i]; });
   }
   return make_polytope(std::move(points), std::move(exact), faces, std::move(normals), "A (+) B");
-}
-
-Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& face_begin,
-                const std::vector<int>& corners, std::vector<char>* keep) {
-  constexpr int kPairwiseDegree = 16;  // facets up to this degree are checked corner by corner
-  const int n = static_cast<int>(points.size());
-  const int nf = static_cast<int>(face_begin.size()) - 1;
-  // Edges shorter than kFeatureTolerance times the diagonal are collapsed; each cluster
-  // keeps the position of its lowest-index vertex (an exact result vertex, rounded).
-  V3<double> lo{0, 0, 0}, hi{0, 0, 0};
-  if (n > 0) lo = hi = points[0];
-  for (const auto& p : points) {
-    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
-  }
-  const V3<double> span = hi - lo;
-  const double limit = kFeatureTolerance * std::sqrt(dot(span, span));
-  std::vector<int> rep(n);
-  std::iota(rep.begin(), rep.end(), 0);
-  auto find = [&](int x) {
-    while (rep[x] != x) x = rep[x] = rep[rep[x]];
-    return x;
-  };
-  auto merge_if_close = [&](int u, int w) {
-    const V3<double> d = points[u] - points[w];
-    if (std::sqrt(dot(d, d)) <= limit) {
-      const int a = find(u), b = find(w);
-      if (a != b) rep[std::max(a, b)] = std::min(a, b);
-    }
-  };
-  for (int f = 0; f < nf; ++f) {
-    const int b = face_begin[f], e = face_begin[f + 1];
-    if (e - b <= kPairwiseDegree) {  // also across a facet: the diagonal of a thin parallelogram
-      for (int c = b; c < e; ++c)
-        for (int d = c + 1; d < e; ++d) merge_if_close(corners[c], corners[d]);
-    } else {
-      for (int c = b; c < e; ++c) merge_if_close(corners[c], corners[c + 1 == e ? b : c + 1]);
-    }
-  }
-  Mesh mesh;
-  std::vector<Mesh::VertexHandle> handle(n);
-  std::vector<char> used(n, 0);
-  std::vector<std::vector<int>> faces(nf);
-  if (keep) keep->assign(nf, 0);
-  for (int f = 0; f < nf; ++f) {
-    auto& cyc = faces[f];
-    for (int c = face_begin[f]; c < face_begin[f + 1]; ++c) {
-      const int v = find(corners[c]);
-      if (cyc.empty() || cyc.back() != v) cyc.push_back(v);
-    }
-    while (cyc.size() > 1 && cyc.front() == cyc.back()) cyc.pop_back();
-    // A facet that still visits a vertex twice has collapsed onto a path: no area left.
-    std::vector<int> sorted = cyc;
-    std::sort(sorted.begin(), sorted.end());
-    if (cyc.size() < 3 || std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
-      cyc.clear();
-      continue;
-    }
-    for (int v : cyc) used[v] = 1;
-  }
-  for (int v = 0; v < n; ++v)
-    if (used[v]) handle[v] = mesh.add_vertex(Point(points[v].x, points[v].y, points[v].z));
-  std::vector<Mesh::VertexHandle> fh;
-  for (int f = 0; f < nf; ++f) {
-    if (faces[f].empty()) continue;
-    fh.clear();
-    for (int v : faces[f]) fh.push_back(handle[v]);
-    if (!mesh.add_face(fh).is_valid())
-      throw error("internal error: facet " + std::to_string(f) +
-                  " of the result could not be joined to its neighbours after merging features below "
-                  "double precision");
-    if (keep) (*keep)[f] = 1;
-  }
-  return mesh;
 }
 
 }  // namespace morph::detail

@@ -3,8 +3,11 @@
 #pragma once
 
 #include <tbb/blocked_range.h>
+#include <tbb/info.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+
+#include <algorithm>
 
 namespace morph::detail {
 
@@ -12,7 +15,8 @@ namespace morph::detail {
 template <class F>
 auto run_with_threads(int threads, F&& f) {
   if (threads <= 0) return f();
-  tbb::task_arena arena(threads);
+  // More threads than cores buys nothing and makes TBB print a warning.
+  tbb::task_arena arena(std::min(threads, tbb::info::default_concurrency()));
   return arena.execute(std::forward<F>(f));
 }
 

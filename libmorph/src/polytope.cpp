@@ -284,7 +284,9 @@ Polytope make_polytope(std::vector<V3<double>> points, std::vector<V3<Exact>> ex
     std::iota(p.vertex_source.begin(), p.vertex_source.end(), 0);
   }
   p.face_source = face_source;
-  p.edge_source.assign(p.num_edges(), -1);
+  // Edges are labelled by their own index unless a mesh says otherwise (make_polytope(Mesh)).
+  p.edge_source.resize(p.num_edges());
+  std::iota(p.edge_source.begin(), p.edge_source.end(), 0);
   // The Gauss map must be valid: the normals around every vertex turn strictly
   // counter-clockwise (a convex spherical polygon).
   RoundingGuard guard;

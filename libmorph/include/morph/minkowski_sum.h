@@ -48,7 +48,10 @@ struct LabelledMesh {
 /// Result: a closed, 2-manifold, outward-oriented convex polygon mesh; every vertex is
 /// a sum a_i + b_j of input vertices rounded once to double; adjacent coplanar facets are
 /// merged, so it equals the convex hull of all vertex sums with its facets as polygons.
-/// All combinatorial decisions are exact. Output is identical for any thread count.
+/// All combinatorial decisions are exact; vertices are rounded to the nearest double.
+/// Corners of a facet closer than 1e-11 of the bounding-box diagonal (features of the
+/// exact sum that doubles cannot represent) are merged, as in morphology.h.
+/// Output is identical for any thread count.
 /// Complexity: O(n_A + n_B + n_S) expected (contributing vertices by walking B's normal
 /// graph from a neighbour's answer), parallel over facets, vertices and edges of A.
 LabelledMesh minkowski_sum(const Mesh& A, const Mesh& B, const MinkowskiOptions& options = {});

@@ -8,6 +8,13 @@
 // The origin of B is its coordinate origin; parametric elements are centred on it. An
 // element that does not contain the origin translates the results accordingly.
 //
+// Exactness: results are computed exactly (exact predicates and rational coordinates)
+// and each vertex is rounded once, to the nearest double. An exact result can contain
+// features far below what doubles represent (planes of floating-point facets that meet
+// almost, but not exactly, in one point): corners of a facet closer than 1e-11 times the
+// result's bounding-box diagonal are merged (keeping one exact vertex), and facets left
+// without area are dropped. See docs/algorithm.md, "Features below double precision".
+//
 // All inputs are taken by const reference and never modified. Inputs must pass
 // check_convex_polyhedron(); a violation throws invalid_mesh / not_convex naming "A"
 // or "B". Opening and closing chain their two steps on exact values and round once.
