@@ -33,8 +33,11 @@ namespace {
 // Limits on the parameters: beyond them a spec is a mistake, not a structuring element.
 constexpr int kMaxIcosphereLevel = 7;  // 327,680 triangles
 constexpr int kMinSides = 3;           // fewest sides of a polygon
-constexpr int kMaxSides = 4096;        // n of uvsphere and cylinder
-constexpr double kMinExtent = 1e-100;  // radii, edges: cubes of these stay finite in double
+constexpr int kMaxSides = 4096;        // n of a cylinder (n + 2 faces)
+constexpr int kMaxUvSphereSides = 512;  // n of a uvsphere: n^2 faces, 262,144 at most (as level 7)
+// Radii, edges: cubes of these stay finite in double, and squared facet areas (~extent^4,
+// as validation computes them) stay above underflow: at 1e-100 every facet had zero area.
+constexpr double kMinExtent = 1e-50;
 constexpr double kMaxExtent = 1e100;
 
 // Two hull triangles are one face when each lies within this fraction of the
@@ -49,7 +52,7 @@ using HullMesh = CGAL::Surface_mesh<Kernel::Point_3>;
 void require_extent(double value, const char* what) {
   if (!(std::isfinite(value) && value >= kMinExtent && value <= kMaxExtent))
     throw input_error(std::string(what) +
-                      " must be a positive finite number between 1e-100 and 1e100, got " +
+                      " must be a positive finite number between 1e-50 and 1e100, got " +
                       std::to_string(value));
 }
 
@@ -270,7 +273,7 @@ bool names_a_file(std::string_view spec) {
 
 std::string structuring_element_grammar() {
   return "  sphere:r=R[,level=L]     icosphere (geodesic, 20*4^L triangles), L in 0..7, default 2\n"
-         "  uvsphere:r=R[,n=N]       UV sphere, N longitudes x N latitudes, N in 3..4096, default "
+         "  uvsphere:r=R[,n=N]       UV sphere, N longitudes x N latitudes, N in 3..512, default "
          "40\n"
          "  cube:S                   axis-aligned cube of edge S\n"
          "  box:X,Y,Z                axis-aligned box of edges X, Y, Z\n"
@@ -333,8 +336,9 @@ Mesh make_structuring_element(std::string_view spec) {
       {"icosahedron", make_icosahedron},
       {"dodecahedron", make_dodecahedron},
       {"snub_dodecahedron", make_snub_dodecahedron}};
-  for (const auto& [name, make] : by_radius) {
-    if (kind != name) continue;
+  for (const auto& entry : by_radius) {  // not a structured binding: clang 14 cannot capture one
+    if (kind != entry.first) continue;
+    const Maker make = entry.second;
     const auto v = values({{"r", {}}});
     return build([&] { return make(v[0]); });
   }
@@ -381,7 +385,7 @@ Mesh make_icosphere(double radius, int level) {
 
 Mesh make_uv_sphere(double radius, int n) {
   require_extent(radius, "uvsphere radius r");
-  require_count(n, kMinSides, kMaxSides, "uvsphere n");
+  require_count(n, kMinSides, kMaxUvSphereSides, "uvsphere n");
   // Latitude i (1..n-1) at polar angle pi*i/n, longitude j at 2*pi*j/n. The sines and
   // cosines are computed once per circle, so each quad is an isosceles trapezoid up to
   // one rounding per coordinate.
