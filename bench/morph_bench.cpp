@@ -12,6 +12,8 @@
 //   --filter TEXT                Table 1 and morphology: only the pairs whose "A + B" contains TEXT
 //   --loop A B SECONDS [THREADS] only A (+) B with libmorph, repeated for SECONDS (for perf record);
 //                                A and B are sample files, B = "rotated" is A turned as in Table 1
+//   --op erode|open|close        before --loop: loop this operation instead (B scaled as in the
+//                                morphology rows)
 //
 // Every measurement runs once as a warm-up (not counted), then repeats as many times as
 // fit in the budget (3 to 15 times) and reports the median. The hull route is what a user
@@ -71,6 +73,7 @@ struct Settings {
   std::filesystem::path csv_dir;  // empty: no CSV
   std::filesystem::path markdown;  // empty: no file
   std::string filter;              // Table 1 / morphology pairs whose "A + B" contains it
+  std::string loop_op = "sum";     // what --loop repeats: sum, erode, open, close
   double budget_seconds = 1.0;
   int min_reps = 3;
   int max_reps = 15;
@@ -239,6 +242,8 @@ std::string ms(double value) {
   return fixed(value, value >= 100 ? 0 : value >= 10 ? 1 : value >= 1 ? 2 : 3);
 }
 
+std::string ratio(double r) { return fixed(r, r < 10 ? 1 : 0) + "x"; }
+
 std::string markdown(const Table& table) {
   std::ostringstream out;
   out << "### " << table.title << "\n\n|";
@@ -340,7 +345,7 @@ void run_table1(const std::vector<Pair>& pairs, const Settings& settings, Report
     const Timing all = time_median([&] { lib = libmorph_sum(a.mesh, b.mesh, 0); }, settings);
     const Timing ref = time_median([&] { hull = hull_route(a.mesh, b.mesh); }, settings);
     table.rows.push_back({operand_cell(a), operand_cell(b), ms(one.median_ms), ms(all.median_ms),
-                          ms(ref.median_ms), fixed(ref.median_ms / one.median_ms, 0) + "x",
+                          ms(ref.median_ms), ratio(ref.median_ms / one.median_ms),
                           std::to_string(lib.vertices) + " / " + std::to_string(lib.facets),
                           std::to_string(hull.vertices) + " / " + std::to_string(hull.facets),
                           std::to_string(one.reps) + " / " + std::to_string(ref.reps)});
@@ -471,11 +476,25 @@ std::string peak_memory(const std::string& series, int parameter) {
 int run_loop(const Settings& settings, const std::string& a_file, const std::string& b_file, double seconds,
              int threads) {
   const Mesh a = morph::read_mesh(settings.samples / a_file);
-  const Mesh b = b_file == "rotated" ? rotated(a, kRotationAngle) : morph::read_mesh(settings.samples / b_file);
+  Mesh b = b_file == "rotated" ? rotated(a, kRotationAngle) : morph::read_mesh(settings.samples / b_file);
+  const auto op = settings.loop_op == "erode" ? &morph::erode
+                  : settings.loop_op == "open" ? &morph::open
+                  : settings.loop_op == "close" ? &morph::close
+                                                : nullptr;
+  if (!op && settings.loop_op != "sum") throw std::runtime_error("unknown --op " + settings.loop_op);
+  if (op) b = scaled(b, kMorphologyScale);
   const auto start = Clock::now();
   int runs = 0;
   Counts out;
-  while (milliseconds_since(start) < seconds * 1000.0) out = libmorph_sum(a, b, threads), ++runs;
+  while (milliseconds_since(start) < seconds * 1000.0) {
+    if (op) {
+      const auto r = op(a, b, {.threads = threads});
+      out = {r.mesh.n_vertices(), r.mesh.n_faces()};
+    } else {
+      out = libmorph_sum(a, b, threads);
+    }
+    ++runs;
+  }
   std::printf("%d runs, %.3f ms each, %zu vertices, %zu facets\n", runs, milliseconds_since(start) / runs,
               out.vertices, out.facets);
   return 0;
@@ -545,10 +564,18 @@ std::string cpu_model() {
   return "unknown";
 }
 
+std::string load_average() {
+  std::ifstream in("/proc/loadavg");
+  double one = 0, five = 0, fifteen = 0;
+  in >> one >> five >> fifteen;
+  return fixed(one, 2) + " " + fixed(five, 2) + " " + fixed(fifteen, 2);
+}
+
 std::string machine() {
   std::ostringstream out;
   out << "Machine: " << cpu_model() << ", " << std::thread::hardware_concurrency()
-      << " hardware threads (nproc " << sysconf(_SC_NPROCESSORS_ONLN) << ")\n\n";
+      << " hardware threads (nproc " << sysconf(_SC_NPROCESSORS_ONLN)
+      << "); load average at start " << load_average() << "\n\n";
   return out.str();
 }
 
@@ -556,7 +583,7 @@ void usage(std::ostream& out) {
   out << "usage: morph-bench [--table1] [--morphology] [--scaling] [--all]\n"
          "                   [--csv DIR] [--markdown FILE] [--samples DIR] [--budget SECONDS]\n"
          "                   [--filter TEXT]\n"
-         "       morph-bench [--samples DIR] --loop A.off B.off|rotated SECONDS [THREADS]\n"
+         "       morph-bench [--samples DIR] [--op OP] --loop A.off B.off|rotated SECONDS [THREADS]\n"
          "  no selection: Table 1, morphology and a quick scaling run\n";
 }
 
@@ -582,6 +609,7 @@ int main(int argc, char** argv) {
       else if (arg == "--samples") settings.samples = value();
       else if (arg == "--budget") settings.budget_seconds = std::stod(value());
       else if (arg == "--filter") settings.filter = value();
+      else if (arg == "--op") settings.loop_op = value();
       else if (arg == "--loop") {
         const std::string a = value(), b = value();
         const double seconds = std::stod(value());
@@ -603,6 +631,7 @@ int main(int argc, char** argv) {
       if (settings.morphology) run_morphology(pairs, settings, report);
     }
     if (settings.scaling) run_scaling(settings, report);
+    report.text("Load average at end " + load_average() + "\n");
     report.finish();
     return 0;
   } catch (const std::exception& e) {
