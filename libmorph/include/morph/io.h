@@ -4,7 +4,8 @@
 // Readers never pass coordinates through float. Writers print 17 significant digits
 // (max_digits10), so a write-then-read round trip is bit-exact. Every malformed input
 // is an input_error naming the file and the line or element; sizes beyond ReadLimits
-// are a limit_error. Files are written atomically: a temporary file beside the target,
+// are a limit_error (readers may also throw invalid_mesh for faces that cannot form a
+// manifold mesh). Reading and writing are linear in the file size. Files are written atomically: a temporary file beside the target,
 // then a rename, so a failed write never leaves a partial file nor clobbers the target.
 #pragma once
 

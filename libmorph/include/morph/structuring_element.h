@@ -28,7 +28,8 @@ std::string structuring_element_grammar();
 /// Throws input_error for a bad spec, io_error/input_error for a bad file.
 Mesh make_structuring_element(std::string_view spec);
 
-/// Generators, all centred on the origin with outward-oriented faces.
+/// Generators, all centred on the origin with outward-oriented faces; linear in their
+/// output size. Non-positive or non-finite sizes throw input_error.
 Mesh make_icosphere(double radius, int level);       // 20*4^level triangles
 Mesh make_uv_sphere(double radius, int n);           // n >= 3
 Mesh make_box(double x, double y, double z);         // 6 quads

@@ -14,6 +14,8 @@
 //      on or below the plane of every neighbouring face, to within kPlanarityTolerance*D.
 // A closed surface of genus 0 that is convex at every edge bounds a convex body.
 // The tolerance only accepts or rejects input; the kernel's own decisions are exact.
+// Every check is linear in the mesh size (the convexity pass is linear in the sum of the
+// squared facet degrees) and never throws, except prepare_convex_polyhedron.
 #pragma once
 
 #include <morph/mesh.h>
