@@ -11,6 +11,7 @@
 #include <map>
 #include <numeric>
 #include <set>
+#include <tuple>
 
 #include "fims.h"
 
@@ -133,15 +134,12 @@ Mesh build_by_hull(const std::vector<V3<double>>& points, const std::vector<int>
   // Boundary cycle of each group; a group that is not one disc keeps its triangles.
   std::map<int, std::vector<HullMesh::Face_index>> groups;
   for (auto t : hull.faces()) groups[facet[t]].push_back(t);
+  // CGAL's hull keys internal maps by pointer, so its order is not reproducible: everything
+  // below is ordered by cluster index instead (vertices, cycle starts, loose triangles).
   Mesh mesh;
   std::map<int, Mesh::VertexHandle> handle;
-  auto vertex = [&](HullMesh::Vertex_index v) {
-    const int cl = cluster_of.at(hull.point(v));
-    auto it = handle.find(cl);
-    if (it != handle.end()) return it->second;
-    const auto& p = points[cl];
-    return handle[cl] = mesh.add_vertex(Point(p.x, p.y, p.z));
-  };
+  auto vertex = [&](HullMesh::Vertex_index v) { return handle.at(cluster_of.at(hull.point(v))); };
+  auto cluster = [&](HullMesh::Vertex_index v) { return cluster_of.at(hull.point(v)); };
   std::vector<std::pair<std::vector<HullMesh::Vertex_index>, int>> out_faces;
   for (auto& [g, tris] : groups) {
     std::map<HullMesh::Vertex_index, HullMesh::Vertex_index> next;
@@ -152,24 +150,39 @@ Mesh build_by_hull(const std::vector<V3<double>>& points, const std::vector<int>
           disc = disc && next.emplace(hull.source(h), hull.target(h)).second;
     std::vector<HullMesh::Vertex_index> cyc;
     if (disc && !next.empty()) {
-      auto v = next.begin()->first;
+      auto start = next.begin()->first;
+      for (const auto& [v, w] : next)
+        if (cluster(v) < cluster(start)) start = v;
+      auto v = start;
       do {
         cyc.push_back(v);
         v = next.at(v);
-      } while (v != next.begin()->first && cyc.size() <= next.size());
+      } while (v != start && cyc.size() <= next.size());
       disc = cyc.size() == next.size();
     }
     const int src = g < nf ? g : -1;
     if (disc) {
       out_faces.emplace_back(std::move(cyc), src);
     } else {
+      std::vector<std::vector<HullMesh::Vertex_index>> loose;
       for (auto t : tris) {
         std::vector<HullMesh::Vertex_index> tri;
         for (auto v : CGAL::vertices_around_face(hull.halfedge(t), hull)) tri.push_back(v);
-        out_faces.emplace_back(std::move(tri), src);
+        std::rotate(tri.begin(), std::min_element(tri.begin(), tri.end(), [&](auto a, auto b) {
+                      return cluster(a) < cluster(b);
+                    }), tri.end());
+        loose.push_back(std::move(tri));
       }
+      std::sort(loose.begin(), loose.end(), [&](const auto& a, const auto& b) {
+        return std::make_tuple(cluster(a[0]), cluster(a[1]), cluster(a[2])) <
+               std::make_tuple(cluster(b[0]), cluster(b[1]), cluster(b[2]));
+      });
+      for (auto& tri : loose) out_faces.emplace_back(std::move(tri), src);
     }
   }
+  for (const auto& f : out_faces)
+    for (auto v : f.first) handle[cluster(v)];
+  for (auto& [cl, h] : handle) h = mesh.add_vertex(Point(points[cl].x, points[cl].y, points[cl].z));
   std::vector<int> src;
   std::vector<Mesh::VertexHandle> fh;
   for (auto& [cyc, s] : out_faces) {
