@@ -22,8 +22,8 @@ namespace {
 using Kernel = CGAL::Exact_predicates_exact_constructions_kernel;
 using HullMesh = CGAL::Surface_mesh<Kernel::Point_3>;
 
-/// Facet cycles over clusters, or empty optional when the cycles no longer describe a
-/// manifold (then the hull route is taken).
+/// Builds `mesh` from the facet cycles over clusters; false (mesh untouched) when they no
+/// longer describe a closed manifold, and the hull route must be taken.
 bool build_direct(const std::vector<V3<double>>& points, const std::vector<int>& face_begin,
                   const std::vector<int>& corners, const std::vector<int>& rep, Mesh& mesh,
                   std::vector<int>* source) {
