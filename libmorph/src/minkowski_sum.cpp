@@ -3,7 +3,6 @@
 #include "fims.h"
 
 #include <morph/error.h>
-#include <morph/validate.h>
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_sort.h>
@@ -248,11 +247,9 @@ Polytope sum_polytope(const Polytope& A, const Polytope& B, const SumFacets& fac
 namespace morph {
 
 LabelledMesh minkowski_sum(const Mesh& A, const Mesh& B, const MinkowskiOptions& options) {
-  const PreparedMesh a = prepare_convex_polyhedron(A, "A");
-  const PreparedMesh b = prepare_convex_polyhedron(B, "B");
   return detail::run_with_threads(options.threads, [&] {
-    const detail::Polytope pa = detail::make_polytope(a.mesh, "A");
-    const detail::Polytope pb = detail::make_polytope(b.mesh, "B");
+    const detail::Polytope pa = detail::make_operand(A, "A");
+    const detail::Polytope pb = detail::make_operand(B, "B");
     return detail::sum_mesh(pa, pb, detail::fims_facets(pa, pb));
   });
 }

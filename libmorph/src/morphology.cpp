@@ -2,7 +2,6 @@
 // exact polytopes from one step to the next and round once, at the end.
 #include <morph/morphology.h>
 
-#include <morph/validate.h>
 
 #include "fims.h"
 #include "halfspace_intersection.h"
@@ -19,9 +18,7 @@ struct Operands {
 };
 
 Operands prepare(const Mesh& A, const Mesh& B) {
-  const PreparedMesh a = prepare_convex_polyhedron(A, "A");
-  const PreparedMesh b = prepare_convex_polyhedron(B, "B");
-  return {detail::make_polytope(a.mesh, "A"), detail::make_polytope(b.mesh, "B")};
+  return {detail::make_operand(A, "A"), detail::make_operand(B, "B")};
 }
 
 MorphResult empty_result(const detail::MaybePolytope& m) {

@@ -1,6 +1,7 @@
 #include "polytope.h"
 
 #include <morph/error.h>
+#include <morph/validate.h>
 
 #include <mpfr.h>
 
@@ -339,6 +340,10 @@ Polytope make_polytope(const Mesh& mesh, const char* name) {
     p.edge_source[e] = h.is_valid() ? mesh.edge_handle(h).idx() : -1;
   }
   return p;
+}
+
+Polytope make_operand(const Mesh& mesh, const char* name) {
+  return make_polytope(prepare_convex_polyhedron(mesh, name).mesh, name);
 }
 
 Mesh to_mesh(const Polytope& p) {

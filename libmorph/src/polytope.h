@@ -107,6 +107,10 @@ Polytope make_polytope(std::vector<V3<double>> points, std::vector<V3<Exact>> ex
                        const std::vector<std::vector<int>>& faces, std::vector<V3<ExactN>> given_normals,
                        const char* name);
 
+/// An operand: checks `mesh` with prepare_convex_polyhedron (throwing invalid_mesh /
+/// not_convex prefixed with `name`, flipping a fully inverted mesh) and builds its polytope.
+Polytope make_operand(const Mesh& mesh, const char* name);
+
 /// The mesh of a polytope (its rounded positions), with facets in polytope order.
 Mesh to_mesh(const Polytope& p);
 
