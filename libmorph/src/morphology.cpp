@@ -2,7 +2,6 @@
 // exact polytopes from one step to the next and round once, at the end.
 #include <morph/morphology.h>
 
-
 #include "fims.h"
 #include "halfspace_intersection.h"
 #include "parallel.h"
