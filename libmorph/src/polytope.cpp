@@ -10,6 +10,8 @@
 #include <string>
 #include <unordered_map>
 
+#include "validate_detail.h"
+
 namespace morph::detail {
 
 double round_to_nearest(const Exact& q) {
@@ -21,17 +23,29 @@ double round_to_nearest(const Exact& q) {
   return d;
 }
 
+Polytope::ExactCache::ExactCache(int n)
+    : slot(std::make_unique<std::atomic<const V3<ExactN>*>[]>(n)), size(n) {}
+
+Polytope::ExactCache::~ExactCache() {
+  for (int f = 0; f < size; ++f) delete slot[f].load(std::memory_order_relaxed);
+}
+
 const V3<ExactN>& Polytope::exact_normal(int f) const {
   if (!given_normals.empty()) return given_normals[f];
-  ExactCache& cache = *exact_cache_;
-  std::call_once(cache.once[f], [&] {
-    const int b = face_begin[f];
-    std::vector<V3<ExactN>> cycle;
-    cycle.reserve(degree(f));
-    for (int k = 0; k < degree(f); ++k) cycle.push_back(to_exact_n(points[corner_vertex[b + k]]));
-    cache.value[f] = newell_normal<ExactN>(degree(f), [&](int i) -> const V3<ExactN>& { return cycle[i]; });
-  });
-  return cache.value[f];
+  std::atomic<const V3<ExactN>*>& slot = exact_cache_->slot[f];
+  if (const V3<ExactN>* known = slot.load(std::memory_order_acquire)) return *known;
+  const int b = face_begin[f];
+  std::vector<V3<ExactN>> cycle;
+  cycle.reserve(degree(f));
+  for (int k = 0; k < degree(f); ++k) cycle.push_back(to_exact_n(points[corner_vertex[b + k]]));
+  auto computed = std::make_unique<const V3<ExactN>>(
+      newell_normal<ExactN>(degree(f), [&](int i) -> const V3<ExactN>& { return cycle[i]; }));
+  // Two threads may compute the same normal; the first to publish wins.
+  const V3<ExactN>* expected = nullptr;
+  if (slot.compare_exchange_strong(expected, computed.get(), std::memory_order_acq_rel,
+                                   std::memory_order_acquire))
+    return *computed.release();
+  return *expected;
 }
 
 void Polytope::compute_normals() {
@@ -45,9 +59,7 @@ void Polytope::compute_normals() {
     for (int k = 0; k < degree(f); ++k) cycle.push_back(interval_point(corner_vertex[b + k]));
     normals[f] = newell_normal<Interval>(degree(f), [&](int i) -> const V3<Interval>& { return cycle[i]; });
   }
-  exact_cache_ = std::make_shared<ExactCache>();
-  exact_cache_->once = std::make_unique<std::once_flag[]>(nf);
-  exact_cache_->value = std::make_unique<V3<ExactN>[]>(nf);
+  exact_cache_ = std::make_shared<ExactCache>(nf);
 }
 
 namespace {
@@ -162,6 +174,146 @@ int edge_convexity(const Polytope& p, const Polytope::Edge& e) {
                           to_exact_n(p.points[e.to]) - to_exact_n(p.points[e.from])));
   return CGAL::sign(det(to_rational(p.exact_normal(e.left)), to_rational(p.exact_normal(e.right)),
                         p.exact_point(e.to) - p.exact_point(e.from)));
+}
+
+/// The Gauss map must be valid: the normals around every vertex turn strictly
+/// counter-clockwise (a convex spherical polygon).
+void check_gauss_map(const Polytope& p, const char* name) {
+  RoundingGuard guard;
+  for (int v = 0; v < p.num_vertices(); ++v) {
+    const int b = p.fan_begin[v], n = p.fan_begin[v + 1] - b;
+    if (n < 3)
+      fail(name, "vertex " + std::to_string(p.vertex_source[v]) + " has fewer than three facets");
+    for (int i = 0; i < n; ++i) {
+      const int s = filtered_sign(
+          [](const auto& a, const auto& c, const auto& d) { return det(a, c, d); },
+          NormalRef{&p, p.fan_face[b + i]}, NormalRef{&p, p.fan_face[b + (i + 1) % n]},
+          NormalRef{&p, p.fan_face[b + (i + 2) % n]});
+      if (s <= 0)
+        fail(name, "the facets around vertex " + std::to_string(p.vertex_source[v]) +
+                       " do not turn convexly (the mesh is not convex)");
+    }
+  }
+}
+
+void check_edges_convex(const Polytope& p, const char* name) {
+  RoundingGuard guard;
+  for (const auto& e : p.edges)
+    if (edge_convexity(p, e) <= 0)
+      fail(name, "edge " + std::to_string(p.vertex_source[e.from]) + "-" +
+                     std::to_string(p.vertex_source[e.to]) + " is not convex");
+}
+
+/// Whether every edge is strictly convex and every vertex has at least three facets:
+/// then the polytope is canonical as it is (nothing to merge or remove).
+bool is_canonical(const Polytope& p) {
+  for (int v = 0; v < p.num_vertices(); ++v)
+    if (p.fan_begin[v + 1] - p.fan_begin[v] < 3) return false;
+  RoundingGuard guard;
+  for (const auto& e : p.edges)
+    if (edge_convexity(p, e) <= 0) return false;
+  return true;
+}
+
+/// Faces, edges and fans of `p` straight from the halfedges of `mesh` (closed, manifold,
+/// no deleted elements), each facet reversed if `order` says so. The numbering is the one
+/// build_connectivity gives the mesh's face cycles: facets in face order, corners from the
+/// face circulator's first vertex, edges in order of first use. Returns the mesh edge of
+/// each polytope edge.
+std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, FaceOrder order) {
+  const int nv = static_cast<int>(mesh.n_vertices());
+  const int nf = static_cast<int>(mesh.n_faces());
+  const int nh = static_cast<int>(mesh.n_halfedges());
+  const bool reversed = order == FaceOrder::reversed;
+  // Corner c is halfedge corner_halfedge[c] of its face: leaving the corner's vertex when
+  // as given; when reversed, entering it (the facet runs against the halfedges).
+  std::vector<int> corner_halfedge(nh), corner_face(nh), corner_of(nh, -1);
+  p.face_begin.resize(nf + 1);
+  p.corner_vertex.resize(nh);
+  int c = 0;
+  for (int f = 0; f < nf; ++f) {
+    p.face_begin[f] = c;
+    const auto h0 = mesh.halfedge_handle(Mesh::FaceHandle(f));
+    // The face circulator starts at the target of h0.
+    const auto start = reversed ? mesh.prev_halfedge_handle(h0) : mesh.next_halfedge_handle(h0);
+    auto h = start;
+    do {
+      if (c == nh) throw error("internal error: a mesh face is not a closed cycle");
+      p.corner_vertex[c] = (reversed ? mesh.to_vertex_handle(h) : mesh.from_vertex_handle(h)).idx();
+      corner_halfedge[c] = h.idx();
+      corner_face[c] = f;
+      corner_of[h.idx()] = c;
+      ++c;
+      h = reversed ? mesh.prev_halfedge_handle(h) : mesh.next_halfedge_handle(h);
+    } while (h != start);
+  }
+  p.face_begin[nf] = c;
+  if (c != nh) throw error("internal error: a mesh halfedge has no face");
+  const int nc = c;
+  // twin[c]: the corner of the other facet on c's edge (its halfedge is the opposite one;
+  // OpenMesh stores the two halfedges of edge e as 2e and 2e + 1).
+  std::vector<int> twin(nc);
+  for (c = 0; c < nc; ++c) twin[c] = corner_of[corner_halfedge[c] ^ 1];
+  auto next_corner = [&](int k) {
+    return k + 1 == p.face_begin[corner_face[k] + 1] ? p.face_begin[corner_face[k]] : k + 1;
+  };
+  auto prev_corner = [&](int k) {
+    return k == p.face_begin[corner_face[k]] ? p.face_begin[corner_face[k] + 1] - 1 : k - 1;
+  };
+
+  std::vector<int> edge_of(mesh.n_edges(), -1), mesh_edge;
+  mesh_edge.reserve(mesh.n_edges());
+  p.edges.clear();
+  p.edges.reserve(mesh.n_edges());
+  p.corner_edge.resize(nc);
+  for (c = 0; c < nc; ++c) {
+    int& e = edge_of[corner_halfedge[c] >> 1];
+    if (e < 0) {
+      e = static_cast<int>(p.edges.size());
+      p.edges.push_back({p.corner_vertex[c], p.corner_vertex[next_corner(c)], corner_face[c],
+                         corner_face[twin[c]]});
+      mesh_edge.push_back(corner_halfedge[c] >> 1);
+    }
+    p.corner_edge[c] = e;
+  }
+
+  // Fans, walked as build_connectivity does: from the last corner at v, the next facet
+  // counter-clockwise is across the incoming edge u -> v.
+  std::vector<int> some_corner(nv, -1);
+  for (c = 0; c < nc; ++c) some_corner[p.corner_vertex[c]] = c;
+  p.fan_begin.resize(nv + 1);
+  p.fan_face.resize(nc);
+  p.fan_edge.resize(nc);
+  p.fan_vertex.resize(nc);
+  int slot = 0;
+  for (int v = 0; v < nv; ++v) {
+    p.fan_begin[v] = slot;
+    const int first = some_corner[v];
+    if (first < 0) continue;
+    c = first;
+    do {
+      if (slot == nc) throw error("internal error: a mesh vertex has a broken fan");
+      const int pc = prev_corner(c);
+      p.fan_face[slot] = corner_face[c];
+      p.fan_edge[slot] = p.corner_edge[pc];
+      p.fan_vertex[slot] = p.corner_vertex[pc];
+      ++slot;
+      c = twin[pc];
+    } while (c != first);
+  }
+  p.fan_begin[nv] = slot;
+  if (slot != nc) throw error("internal error: a mesh vertex has several fans");
+  return mesh_edge;
+}
+
+bool has_deleted_elements(const Mesh& mesh) {
+  for (auto v : mesh.all_vertices())
+    if (mesh.status(v).deleted()) return true;
+  for (auto e : mesh.all_edges())
+    if (mesh.status(e).deleted()) return true;
+  for (auto f : mesh.all_faces())
+    if (mesh.status(f).deleted()) return true;
+  return false;
 }
 
 }  // namespace
@@ -288,50 +440,46 @@ Polytope make_polytope(std::vector<V3<double>> points, std::vector<V3<Exact>> ex
   // Edges are labelled by their own index unless a mesh says otherwise (make_polytope(Mesh)).
   p.edge_source.resize(p.num_edges());
   std::iota(p.edge_source.begin(), p.edge_source.end(), 0);
-  // The Gauss map must be valid: the normals around every vertex turn strictly
-  // counter-clockwise (a convex spherical polygon).
-  RoundingGuard guard;
-  for (int v = 0; v < p.num_vertices(); ++v) {
-    const int b = p.fan_begin[v], n = p.fan_begin[v + 1] - b;
-    if (n < 3) fail(name, "vertex " + std::to_string(p.vertex_source[v]) + " has fewer than three facets");
-    for (int i = 0; i < n; ++i) {
-      const int s = filtered_sign([](const auto& a, const auto& c, const auto& d) { return det(a, c, d); },
-                                  NormalRef{&p, p.fan_face[b + i]}, NormalRef{&p, p.fan_face[b + (i + 1) % n]},
-                                  NormalRef{&p, p.fan_face[b + (i + 2) % n]});
-      if (s <= 0)
-        fail(name, "the facets around vertex " + std::to_string(p.vertex_source[v]) +
-                       " do not turn convexly (the mesh is not convex)");
-    }
-  }
-  for (const auto& e : p.edges)
-    if (edge_convexity(p, e) <= 0)
-      fail(name, "edge " + std::to_string(p.vertex_source[e.from]) + "-" + std::to_string(p.vertex_source[e.to]) +
-                     " is not convex");
+  check_gauss_map(p, name);
+  check_edges_convex(p, name);
   return p;
 }
 
-Polytope make_polytope(const Mesh& mesh, const char* name) {
+Polytope make_polytope_from_cycles(const Mesh& mesh, const char* name, FaceOrder order) {
+  // Dense numbering of the mesh's live vertices and faces (identity without deleted ones).
+  std::vector<int> dense(mesh.n_vertices(), -1), mesh_vertex, mesh_face;
   std::vector<V3<double>> points;
   points.reserve(mesh.n_vertices());
   for (auto v : mesh.vertices()) {
     const auto& q = mesh.point(v);
+    dense[v.idx()] = static_cast<int>(points.size());
     points.push_back({q[0], q[1], q[2]});
+    mesh_vertex.push_back(v.idx());
   }
   std::vector<std::vector<int>> faces;
   faces.reserve(mesh.n_faces());
   for (auto f : mesh.faces()) {
     std::vector<int> cyc;
-    for (auto v : f.vertices()) cyc.push_back(v.idx());
+    for (auto v : f.vertices()) cyc.push_back(dense[v.idx()]);
+    if (order == FaceOrder::reversed) std::reverse(cyc.begin(), cyc.end());
     faces.push_back(std::move(cyc));
+    mesh_face.push_back(f.idx());
   }
   Polytope p = make_polytope(std::move(points), {}, faces, {}, name);
+  for (int& v : p.vertex_source) v = mesh_vertex[v];
+  for (int& f : p.face_source) f = mesh_face[f];
   for (int e = 0; e < p.num_edges(); ++e) {
-    const int u = p.vertex_source[p.edges[e].from], w = p.vertex_source[p.edges[e].to];
-    auto h = mesh.find_halfedge(mesh.vertex_handle(u), mesh.vertex_handle(w));
+    const auto u = mesh.vertex_handle(p.vertex_source[p.edges[e].from]);
+    const auto w = mesh.vertex_handle(p.vertex_source[p.edges[e].to]);
+    auto h = mesh.find_halfedge(u, w);
     if (!h.is_valid()) {
-      // The polytope edge spans removed vertices: label it with its first mesh edge.
-      for (auto oh : mesh.voh_range(mesh.vertex_handle(u))) {
-        if (mesh.face_handle(oh).is_valid() && mesh.face_handle(oh).idx() == p.face_source[p.edges[e].left]) {
+      // The polytope edge spans removed vertices: label it with its first mesh edge, the
+      // one at u on the side of its left facet (the face runs u -> x, or x -> u when the
+      // faces are reversed).
+      for (auto oh : mesh.voh_range(u)) {
+        const auto side = order == FaceOrder::reversed ? mesh.opposite_halfedge_handle(oh) : oh;
+        if (mesh.face_handle(side).is_valid() &&
+            mesh.face_handle(side).idx() == p.face_source[p.edges[e].left]) {
           h = oh;
           break;
         }
@@ -342,8 +490,30 @@ Polytope make_polytope(const Mesh& mesh, const char* name) {
   return p;
 }
 
+Polytope make_polytope(const Mesh& mesh, const char* name, FaceOrder order) {
+  if (has_deleted_elements(mesh)) return make_polytope_from_cycles(mesh, name, order);
+  Polytope p;
+  p.points.resize(mesh.n_vertices());
+  for (auto v : mesh.vertices()) {
+    const auto& q = mesh.point(v);
+    p.points[v.idx()] = {q[0], q[1], q[2]};
+  }
+  std::vector<int> mesh_edge = connectivity_from_halfedges(p, mesh, order);
+  p.compute_normals();
+  if (!is_canonical(p)) return make_polytope_from_cycles(mesh, name, order);
+  p.vertex_source.resize(p.num_vertices());
+  std::iota(p.vertex_source.begin(), p.vertex_source.end(), 0);
+  p.face_source.resize(p.num_faces());
+  std::iota(p.face_source.begin(), p.face_source.end(), 0);
+  p.edge_source = std::move(mesh_edge);
+  // Every edge is strictly convex (is_canonical); the Gauss map is left to check.
+  check_gauss_map(p, name);
+  return p;
+}
+
 Polytope make_operand(const Mesh& mesh, const char* name) {
-  return make_polytope(prepare_convex_polyhedron(mesh, name).mesh, name);
+  const bool inverted = check_operand(mesh, name).has_value();
+  return make_polytope(mesh, name, inverted ? FaceOrder::reversed : FaceOrder::as_given);
 }
 
 Mesh to_mesh(const Polytope& p) {

@@ -18,8 +18,8 @@
 
 #include <morph/mesh.h>
 
+#include <atomic>
 #include <memory>
-#include <mutex>
 #include <vector>
 
 #include "exact.h"
@@ -72,17 +72,21 @@ struct Polytope {
     return exact_points.empty() ? to_interval(points[v]) : to_interval(exact_points[v]);
   }
 
-  /// Exact normal of facet f: given, or Newell's of its points, computed once on first
-  /// use (thread-safe).
+  /// Exact normal of facet f: given, or Newell's of its points, computed on first use and
+  /// kept (thread-safe: racing threads may both compute it, all get the one kept).
   const V3<ExactN>& exact_normal(int f) const;
 
   /// Computes `normals` and resets the exact cache; call after the facets are final.
   void compute_normals();
 
  private:
+  // One slot per facet, filled on first use: a few exact normals are ever needed, so
+  // nothing exact is allocated for the others.
   struct ExactCache {
-    std::unique_ptr<std::once_flag[]> once;
-    std::unique_ptr<V3<ExactN>[]> value;
+    explicit ExactCache(int n);
+    ~ExactCache();
+    std::unique_ptr<std::atomic<const V3<ExactN>*>[]> slot;
+    int size;
   };
   mutable std::shared_ptr<ExactCache> exact_cache_;
 };
@@ -95,10 +99,23 @@ struct NormalRef {
   const V3<ExactN>& exact() const { return polytope->exact_normal(face); }
 };
 
-/// Builds the canonical polytope of a mesh that passed prepare_convex_polyhedron().
+/// How make_polytope reads a mesh's faces: as given, or each reversed (an inverted mesh,
+/// see check_operand).
+enum class FaceOrder : bool { as_given, reversed };
+
+/// Builds the canonical polytope of a mesh that passed check_convex_polyhedron(), or of
+/// the mesh with every facet reversed (`order`, for an inverted mesh):
+/// then each facet cycle is the reverse of the mesh face's. Labels name `mesh`'s elements.
 /// Throws not_convex (prefixed with `name`) if the facets' exact normals do not form a
 /// valid Gauss map (possible only for meshes convex merely within the tolerance).
-Polytope make_polytope(const Mesh& mesh, const char* name);
+/// Complexity: linear, straight from the mesh's halfedges when every edge is strictly
+/// convex and every vertex has three facets; otherwise through the canonical merge.
+Polytope make_polytope(const Mesh& mesh, const char* name, FaceOrder order = FaceOrder::as_given);
+
+/// make_polytope(mesh, name, order) always through the canonical merge of facet cycles (the
+/// general path); for tests, which check that both paths give the same polytope.
+Polytope make_polytope_from_cycles(const Mesh& mesh, const char* name,
+                                   FaceOrder order = FaceOrder::as_given);
 
 /// Builds a polytope from facet cycles over the given vertices (exact positions when
 /// `exact_points` is non-empty, and then one exact normal per facet in `given_normals`),

@@ -17,6 +17,8 @@
 #include <utility>
 #include <vector>
 
+#include "validate_detail.h"
+
 namespace morph {
 namespace {
 
@@ -104,26 +106,34 @@ Finding closed_manifold(const Mesh& mesh) {
   // neighbour once (two edges between the same vertices pinch the surface).
   std::vector<int> outgoing(mesh.n_vertices(), 0);
   for (auto h : mesh.halfedges()) ++outgoing[mesh.from_vertex_handle(h).idx()];
-  std::vector<int> neighbours;
+  // seen[w] == v: w was already reached from v (a stamp, so the array is never cleared).
+  std::vector<int> seen(mesh.n_vertices(), -1);
   for (auto v : mesh.vertices()) {
     ++n_vertices;
     if (outgoing[v.idx()] == 0)
       return fail(Verdict::invalid,
                   "vertex " + std::to_string(v.idx()) + " is isolated (it belongs to no face)");
-    neighbours.clear();
+    int reached = 0;
+    bool pinched = false;
     for (auto h : mesh.voh_range(v)) {
-      neighbours.push_back(mesh.to_vertex_handle(h).idx());
-      if (static_cast<int>(neighbours.size()) > outgoing[v.idx()]) break;  // corrupt links
+      const int w = mesh.to_vertex_handle(h).idx();
+      pinched = pinched || seen[w] == v.idx();
+      seen[w] = v.idx();
+      if (++reached > outgoing[v.idx()]) break;  // corrupt links
     }
-    if (static_cast<int>(neighbours.size()) != outgoing[v.idx()])
+    if (reached != outgoing[v.idx()])
       return fail(Verdict::invalid, "vertex " + std::to_string(v.idx()) +
                                         " is not manifold: its faces form more than one fan");
-    std::sort(neighbours.begin(), neighbours.end());
-    const auto twice = std::adjacent_find(neighbours.begin(), neighbours.end());
-    if (twice != neighbours.end())
+    if (pinched) {
+      // Name the smallest neighbour reached twice.
+      std::vector<int> neighbours;
+      for (auto h : mesh.voh_range(v)) neighbours.push_back(mesh.to_vertex_handle(h).idx());
+      std::sort(neighbours.begin(), neighbours.end());
+      const auto twice = std::adjacent_find(neighbours.begin(), neighbours.end());
       return fail(Verdict::invalid, "vertices " + std::to_string(v.idx()) + " and " +
                                         std::to_string(*twice) +
                                         " are joined by two edges: the mesh is not 2-manifold");
+    }
   }
 
   DisjointSets components(mesh.n_vertices());
@@ -162,9 +172,26 @@ struct FacePlane {
   Point normal{0, 0, 0};  // unit length once the face is known to be non-degenerate
 };
 
-FacePlane newell_plane(const Mesh& mesh, Mesh::FaceHandle f, std::vector<Point>& corners) {
-  corners.clear();
-  for (auto v : mesh.fv_range(f)) corners.push_back(mesh.point(v));
+// What the geometric checks share: the extent, and every face's plane (its Newell
+// normal not yet normalised), computed once by nondegenerate().
+struct Geometry {
+  Extent extent;
+  std::vector<FacePlane> planes;  // by face index
+};
+
+// The vertices of face f in the order of its vertex circulator (starting at the target
+// of the face's halfedge), without the circulator's overhead.
+template <class Visit>
+void for_each_corner(const Mesh& mesh, Mesh::FaceHandle f, const Visit& visit) {
+  const auto first = mesh.halfedge_handle(f);
+  auto h = first;
+  do {
+    visit(mesh.to_vertex_handle(h));
+    h = mesh.next_halfedge_handle(h);
+  } while (h != first);
+}
+
+FacePlane newell_plane(const std::vector<Point>& corners) {
   FacePlane plane;
   for (const auto& p : corners) plane.centroid += p;
   plane.centroid /= static_cast<double>(corners.size());
@@ -176,36 +203,58 @@ FacePlane newell_plane(const Mesh& mesh, Mesh::FaceHandle f, std::vector<Point>&
   return plane;
 }
 
-Finding nondegenerate(const Mesh& mesh) {
+// Whether two of `values` are equal (quadratic: faces are small; sorting would allocate).
+template <class T>
+bool has_equal_pair(const std::vector<T>& values) {
+  for (std::size_t i = 0; i < values.size(); ++i)
+    for (std::size_t j = i + 1; j < values.size(); ++j)
+      if (values[i] == values[j]) return true;
+  return false;
+}
+
+// Fills `geometry` (extent and face planes) for the later checks when the mesh passes.
+Finding nondegenerate(const Mesh& mesh, Geometry& geometry) {
   for (auto v : mesh.vertices()) {
     const Point& p = mesh.point(v);
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
       return fail(Verdict::invalid,
                   "vertex " + std::to_string(v.idx()) + " has a coordinate that is not finite");
   }
-  const double diagonal = bounding_box(mesh).diagonal;
+  geometry.extent = bounding_box(mesh);
+  const double diagonal = geometry.extent.diagonal;
+  geometry.planes.assign(mesh.n_faces(), FacePlane{});
   std::vector<Point> corners;
   std::vector<int> ids;
   for (auto f : mesh.faces()) {
     ids.clear();
-    for (auto v : mesh.fv_range(f)) ids.push_back(v.idx());
-    const std::string face = "face " + std::to_string(f.idx());
+    corners.clear();
+    for_each_corner(mesh, f, [&](Mesh::VertexHandle v) {
+      ids.push_back(v.idx());
+      corners.push_back(mesh.point(v));
+    });
+    const auto face = [&] { return "face " + std::to_string(f.idx()); };
     if (ids.size() < 3)
-      return fail(Verdict::invalid, face + " has " + std::to_string(ids.size()) +
+      return fail(Verdict::invalid, face() + " has " + std::to_string(ids.size()) +
                                         " vertices; a face needs at least 3");
-    std::sort(ids.begin(), ids.end());
-    const auto twice = std::adjacent_find(ids.begin(), ids.end());
-    if (twice != ids.end())
+    if (has_equal_pair(ids)) {
+      std::sort(ids.begin(), ids.end());
+      const auto twice = std::adjacent_find(ids.begin(), ids.end());
       return fail(Verdict::invalid,
-                  face + " uses vertex " + std::to_string(*twice) + " more than once");
-    const FacePlane plane = newell_plane(mesh, f, corners);
-    std::sort(corners.begin(), corners.end());  // lexicographic, to find equal positions
-    if (std::adjacent_find(corners.begin(), corners.end()) != corners.end())
-      return fail(Verdict::invalid, face + " has two vertices at the same position");
+                  face() + " uses vertex " + std::to_string(*twice) + " more than once");
+    }
+    const FacePlane plane = newell_plane(corners);
+    if (has_equal_pair(corners))
+      return fail(Verdict::invalid, face() + " has two vertices at the same position");
     if (!(plane.normal.norm() > kZeroAreaRatio * diagonal * diagonal))
-      return fail(Verdict::invalid, face + " has zero area (its vertices are collinear)");
+      return fail(Verdict::invalid, face() + " has zero area (its vertices are collinear)");
+    geometry.planes[f.idx()] = plane;
   }
   return {};
+}
+
+Finding nondegenerate(const Mesh& mesh) {
+  Geometry geometry;
+  return nondegenerate(mesh, geometry);
 }
 
 // Signed volume relative to `origin`, and the sum of the absolute volumes of the fan
@@ -228,10 +277,10 @@ std::pair<double, double> fan_volumes(const Mesh& mesh, const Point& origin) {
   return {total / 6, absolute / 6};
 }
 
-Finding outward(const Mesh& mesh) {
+Finding outward(const Mesh& mesh, const Extent& extent) {
   // OpenMesh links the two halfedges of every edge in opposite directions, so the faces
   // of a closed mesh are consistently oriented by construction; what remains is the sign.
-  const auto [volume, absolute] = fan_volumes(mesh, bounding_box(mesh).centre);
+  const auto [volume, absolute] = fan_volumes(mesh, extent.centre);
   if (!(std::abs(volume) > kFlatVolumeRatio * absolute))
     return fail(Verdict::invalid,
                 "the mesh encloses no volume (signed volume " + number(volume) + "): it is flat");
@@ -241,22 +290,28 @@ Finding outward(const Mesh& mesh) {
   return {Verdict::ok, {}, volume};
 }
 
-Finding planar_and_convex(const Mesh& mesh, double relative_tolerance) {
-  const double tolerance = relative_tolerance * bounding_box(mesh).diagonal;
-  std::vector<FacePlane> planes(mesh.n_faces());
-  std::vector<Point> corners;
+Finding outward(const Mesh& mesh) { return outward(mesh, bounding_box(mesh)); }
+
+// Planarity, then edge convexity; `geometry` from nondegenerate(), its planes normalised
+// here.
+Finding planar_and_convex(const Mesh& mesh, double relative_tolerance, Geometry& geometry) {
+  const double tolerance = relative_tolerance * geometry.extent.diagonal;
+  std::vector<FacePlane>& planes = geometry.planes;
   for (auto f : mesh.faces()) {
-    FacePlane plane = newell_plane(mesh, f, corners);
+    FacePlane& plane = planes[f.idx()];
     plane.normal.normalize();
-    for (auto v : mesh.fv_range(f)) {
-      const double distance = std::abs(OpenMesh::dot(mesh.point(v) - plane.centroid, plane.normal));
-      if (!(distance <= tolerance))
-        return fail(Verdict::not_convex,
-                    "face " + std::to_string(f.idx()) + " is not planar: vertex " +
-                        std::to_string(v.idx()) + " is " + number(distance) +
-                        " from its plane (tolerance " + number(tolerance) + ")");
-    }
-    planes[f.idx()] = plane;
+    Mesh::VertexHandle off_plane;
+    double distance = 0;
+    for_each_corner(mesh, f, [&](Mesh::VertexHandle v) {
+      if (off_plane.is_valid()) return;
+      distance = std::abs(OpenMesh::dot(mesh.point(v) - plane.centroid, plane.normal));
+      if (!(distance <= tolerance)) off_plane = v;
+    });
+    if (off_plane.is_valid())
+      return fail(Verdict::not_convex,
+                  "face " + std::to_string(f.idx()) + " is not planar: vertex " +
+                      std::to_string(off_plane.idx()) + " is " + number(distance) +
+                      " from its plane (tolerance " + number(tolerance) + ")");
   }
   for (auto e : mesh.edges()) {
     for (int side = 0; side < 2; ++side) {
@@ -264,16 +319,23 @@ Finding planar_and_convex(const Mesh& mesh, double relative_tolerance) {
       const auto f = mesh.face_handle(h);
       const auto g = mesh.opposite_face_handle(h);
       const FacePlane& plane = planes[f.idx()];
-      for (auto v : mesh.fv_range(g)) {
-        const double height = OpenMesh::dot(mesh.point(v) - plane.centroid, plane.normal);
-        if (!(height <= tolerance))
-          return fail(Verdict::not_convex,
-                      "edge " + std::to_string(e.idx()) + " (vertices " + vertex_pair(mesh, e) +
-                          ") is reflex: vertex " + std::to_string(v.idx()) + " of face " +
-                          std::to_string(g.idx()) + " is " + number(height) +
-                          " above the plane of face " + std::to_string(f.idx()) + " (tolerance " +
-                          number(tolerance) + ")");
-      }
+      // The edge's own vertices belong to f and passed the planarity check: their height
+      // is at most the tolerance, so only g's other vertices can fail.
+      const auto from = mesh.from_vertex_handle(h), to = mesh.to_vertex_handle(h);
+      Mesh::VertexHandle above;
+      double height = 0;
+      for_each_corner(mesh, g, [&](Mesh::VertexHandle v) {
+        if (above.is_valid() || v == from || v == to) return;
+        height = OpenMesh::dot(mesh.point(v) - plane.centroid, plane.normal);
+        if (!(height <= tolerance)) above = v;
+      });
+      if (above.is_valid())
+        return fail(Verdict::not_convex, "edge " + std::to_string(e.idx()) + " (vertices " +
+                                             vertex_pair(mesh, e) + ") is reflex: vertex " +
+                                             std::to_string(above.idx()) + " of face " +
+                                             std::to_string(g.idx()) + " is " + number(height) +
+                                             " above the plane of face " + std::to_string(f.idx()) +
+                                             " (tolerance " + number(tolerance) + ")");
     }
   }
   return {};
@@ -283,9 +345,10 @@ Finding planar_and_convex(const Mesh& mesh, double relative_tolerance) {
 // before the geometric checks (which assume outward normals).
 Finding convex_polyhedron(const Mesh& mesh, double relative_tolerance) {
   if (Finding found = closed_manifold(mesh); found.verdict != Verdict::ok) return found;
-  if (Finding found = nondegenerate(mesh); found.verdict != Verdict::ok) return found;
-  if (Finding found = outward(mesh); found.verdict != Verdict::ok) return found;
-  return planar_and_convex(mesh, relative_tolerance);
+  Geometry geometry;
+  if (Finding found = nondegenerate(mesh, geometry); found.verdict != Verdict::ok) return found;
+  if (Finding found = outward(mesh, geometry.extent); found.verdict != Verdict::ok) return found;
+  return planar_and_convex(mesh, relative_tolerance, geometry);
 }
 
 CheckResult to_result(Finding found) { return {std::move(found.problem), {}}; }
@@ -323,22 +386,34 @@ CheckResult check_convex_polyhedron(const Mesh& mesh, const ValidationOptions& o
 
 PreparedMesh prepare_convex_polyhedron(const Mesh& mesh, std::string_view name,
                                        const ValidationOptions& options) {
-  const std::string prefix = std::string(name) + ": ";
+  std::optional<PreparedMesh> flipped = detail::check_operand(mesh, name, options);
+  if (!flipped) return {mesh, {}};
+  return std::move(*flipped);
+}
+
+namespace detail {
+
+std::optional<PreparedMesh> check_operand(const Mesh& mesh, std::string_view name,
+                                          const ValidationOptions& options) {
+  const auto prefix = [&] { return std::string(name) + ": "; };
   const auto raise = [&](const Finding& found) {
-    if (found.verdict == Verdict::not_convex) throw not_convex(prefix + found.problem);
-    throw invalid_mesh(prefix + found.problem);
+    if (found.verdict == Verdict::not_convex) throw not_convex(prefix() + found.problem);
+    throw invalid_mesh(prefix() + found.problem);
   };
   Finding found = convex_polyhedron(mesh, options.planarity_tolerance);
-  if (found.verdict == Verdict::ok) return {mesh, {}};
+  if (found.verdict == Verdict::ok) return std::nullopt;
   if (found.verdict != Verdict::inverted || !options.fix_inverted) raise(found);
 
+  // Rare: check the flipped copy itself, so that messages name its elements as before.
   PreparedMesh prepared{rebuilt(mesh, true), {}};
-  prepared.notes.push_back(prefix + "orientation was inverted (signed volume " +
+  prepared.notes.push_back(prefix() + "orientation was inverted (signed volume " +
                            number(found.volume) + "); the faces were reversed");
   found = convex_polyhedron(prepared.mesh, options.planarity_tolerance);
   if (found.verdict != Verdict::ok) raise(found);
   return prepared;
 }
+
+}  // namespace detail
 
 double signed_volume(const Mesh& mesh) {
   return fan_volumes(mesh, bounding_box(mesh).centre).first;
