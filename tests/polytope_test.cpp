@@ -1,0 +1,255 @@
+// Tests of the kernel's operand polytopes (libmorph/src/polytope.cpp): the linear path
+// straight from the mesh's halfedges against the general path through the canonical merge
+// of facet cycles, and the labels checked against the mesh itself.
+#include "../libmorph/src/polytope.h"
+
+#include <doctest/doctest.h>
+#include <morph/error.h>
+#include <morph/io.h>
+#include <morph/validate.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "support/polytopes.h"
+
+namespace {
+
+using morph::Mesh;
+using morph::Point;
+using morph::detail::FaceOrder;
+using morph::detail::Polytope;
+
+// The first difference between two polytopes (every array, labels and interval normals),
+// or "" when they are the same.
+std::string difference(const Polytope& a, const Polytope& b) {
+  const auto same_points = [](const auto& x, const auto& y) {
+    return x.size() == y.size() &&
+           std::equal(x.begin(), x.end(), y.begin(), [](const auto& p, const auto& q) {
+             return p.x == q.x && p.y == q.y && p.z == q.z;
+           });
+  };
+  if (!same_points(a.points, b.points)) return "points";
+  if (a.face_begin != b.face_begin) return "face_begin";
+  if (a.corner_vertex != b.corner_vertex) return "corner_vertex";
+  if (a.corner_edge != b.corner_edge) return "corner_edge";
+  if (!std::equal(a.edges.begin(), a.edges.end(), b.edges.begin(), b.edges.end(),
+                  [](const Polytope::Edge& x, const Polytope::Edge& y) {
+                    return x.from == y.from && x.to == y.to && x.left == y.left &&
+                           x.right == y.right;
+                  }))
+    return "edges";
+  if (a.fan_begin != b.fan_begin || a.fan_face != b.fan_face || a.fan_edge != b.fan_edge ||
+      a.fan_vertex != b.fan_vertex)
+    return "fans";
+  if (a.vertex_source != b.vertex_source) return "vertex_source";
+  if (a.face_source != b.face_source) return "face_source";
+  if (a.edge_source != b.edge_source) return "edge_source";
+  const auto same_interval = [](const auto& x, const auto& y) {
+    return x.inf() == y.inf() && x.sup() == y.sup();
+  };
+  for (int f = 0; f < a.num_faces(); ++f) {
+    const auto &n = a.normals[f], &m = b.normals[f];
+    if (!same_interval(n.x, m.x) || !same_interval(n.y, m.y) || !same_interval(n.z, m.z))
+      return "normals";
+  }
+  return "";
+}
+
+double diagonal(const Mesh& mesh) {
+  Point lo = mesh.point(*mesh.vertices().begin()), hi = lo;
+  for (auto v : mesh.vertices()) {
+    lo.minimize(mesh.point(v));
+    hi.maximize(mesh.point(v));
+  }
+  return (hi - lo).norm();
+}
+
+// What is wrong with the labels of `p` as a polytope of `mesh` (facets reversed when
+// `order` says so), or "": every vertex is the mesh vertex it names; every facet's named
+// face lies in the facet's plane and faces the same way; every edge's named mesh edge
+// starts at one end of the polytope edge and runs along it.
+std::string labels_problem(const Polytope& p, const Mesh& mesh, FaceOrder order) {
+  const double tolerance = 1e-9 * diagonal(mesh);
+  const auto at = [&](int v) { return Point(p.points[v].x, p.points[v].y, p.points[v].z); };
+  for (int v = 0; v < p.num_vertices(); ++v) {
+    const int s = p.vertex_source[v];
+    if (s < 0 || s >= static_cast<int>(mesh.n_vertices()) ||
+        mesh.status(mesh.vertex_handle(s)).deleted() || mesh.point(mesh.vertex_handle(s)) != at(v))
+      return "vertex " + std::to_string(v) + " is labelled " + std::to_string(s);
+  }
+  for (int f = 0; f < p.num_faces(); ++f) {
+    Point normal(0, 0, 0);
+    for (int k = 0; k < p.degree(f); ++k)
+      normal += OpenMesh::cross(at(p.corner(f, k)), at(p.corner(f, (k + 1) % p.degree(f))));
+    normal.normalize();
+    const auto face = mesh.face_handle(p.face_source[f]);
+    Point face_normal(0, 0, 0);
+    std::vector<Point> corners;
+    for (auto v : mesh.fv_range(face)) corners.push_back(mesh.point(v));
+    for (std::size_t k = 0; k < corners.size(); ++k)
+      face_normal += OpenMesh::cross(corners[k], corners[(k + 1) % corners.size()]);
+    if (order == FaceOrder::reversed) face_normal = -face_normal;
+    if (!(OpenMesh::dot(normal, face_normal) > 0))
+      return "facet " + std::to_string(f) + " is labelled with a face turned the other way";
+    for (const Point& q : corners)
+      if (!(std::abs(OpenMesh::dot(q - at(p.corner(f, 0)), normal)) <= tolerance))
+        return "facet " + std::to_string(f) + " is labelled with a face off its plane";
+  }
+  for (int e = 0; e < p.num_edges(); ++e) {
+    const int s = p.edge_source[e];
+    if (s < 0) return "edge " + std::to_string(e) + " has no label";
+    const auto h = mesh.halfedge_handle(mesh.edge_handle(s), 0);
+    std::set<int> ends = {mesh.from_vertex_handle(h).idx(), mesh.to_vertex_handle(h).idx()};
+    const int from = p.vertex_source[p.edges[e].from], to = p.vertex_source[p.edges[e].to];
+    if (ends == std::set<int>{from, to}) continue;
+    // An edge spanning removed vertices: its label starts at `from` and runs towards `to`.
+    if (!ends.count(from))
+      return "edge " + std::to_string(e) + " is labelled with an edge away from its start";
+    const int other = *ends.begin() == from ? *ends.rbegin() : *ends.begin();
+    const Point d = at(p.edges[e].to) - at(p.edges[e].from);
+    const Point q = mesh.point(mesh.vertex_handle(other)) - at(p.edges[e].from);
+    if (!(OpenMesh::cross(d, q).norm() <= tolerance * d.norm() && OpenMesh::dot(d, q) > 0))
+      return "edge " + std::to_string(e) + " is labelled with an edge off its line";
+  }
+  return "";
+}
+
+// The mesh with every face reversed (an inverted operand).
+Mesh inverted(const Mesh& mesh) {
+  std::vector<std::vector<int>> faces;
+  for (auto f : mesh.faces()) {
+    std::vector<int> cycle;
+    for (auto v : mesh.fv_range(f)) cycle.push_back(v.idx());
+    std::reverse(cycle.begin(), cycle.end());
+    faces.push_back(cycle);
+  }
+  return morph::test::mesh_from_polygons(morph::test::positions(mesh), faces);
+}
+
+// The mesh with every face split into a fan of triangles (coplanar neighbours).
+Mesh triangulated(const Mesh& mesh) {
+  std::vector<std::vector<int>> faces;
+  for (auto f : mesh.faces()) {
+    std::vector<int> cycle;
+    for (auto v : mesh.fv_range(f)) cycle.push_back(v.idx());
+    for (std::size_t k = 1; k + 1 < cycle.size(); ++k)
+      faces.push_back({cycle[0], cycle[k], cycle[k + 1]});
+  }
+  return morph::test::mesh_from_polygons(morph::test::positions(mesh), faces);
+}
+
+// Both paths on `mesh` as given and on its inverse, and the labels.
+void check_both_paths(const Mesh& mesh, const std::string& what) {
+  CAPTURE(what);
+  const Polytope fast = morph::detail::make_polytope(mesh, "A");
+  const Polytope general = morph::detail::make_polytope_from_cycles(mesh, "A");
+  CHECK(difference(fast, general) == "");
+  CHECK(labels_problem(fast, mesh, FaceOrder::as_given) == "");
+  const Mesh inverse = inverted(mesh);
+  const Polytope fast_inverse = morph::detail::make_polytope(inverse, "A", FaceOrder::reversed);
+  const Polytope general_inverse =
+      morph::detail::make_polytope_from_cycles(inverse, "A", FaceOrder::reversed);
+  CHECK(difference(fast_inverse, general_inverse) == "");
+  CHECK(labels_problem(fast_inverse, inverse, FaceOrder::reversed) == "");
+  CHECK(difference(morph::detail::make_operand(inverse, "A"), fast_inverse) == "");
+  CHECK(fast_inverse.num_faces() == fast.num_faces());
+  CHECK(fast_inverse.num_edges() == fast.num_edges());
+  CHECK(morph::signed_volume(morph::detail::to_mesh(fast_inverse)) > 0);
+}
+
+}  // namespace
+
+TEST_CASE("polytope: the halfedge path and the cycle path agree on the samples") {
+  for (const auto& entry : std::filesystem::directory_iterator(MORPH_SAMPLES_DIR)) {
+    if (entry.path().extension() != ".off") continue;
+    const Mesh mesh = morph::read_mesh(entry.path().string());
+    check_both_paths(mesh, entry.path().filename().string());
+    check_both_paths(morph::test::transformed(mesh, morph::test::random_rotation(11)),
+                     entry.path().filename().string() + " rotated");
+  }
+}
+
+TEST_CASE("polytope: generated operands, with and without coplanar neighbours") {
+  check_both_paths(morph::test::cube(2.0), "cube");
+  check_both_paths(triangulated(morph::test::cube(2.0)), "triangulated cube");
+  check_both_paths(morph::test::rotated_cube_quads(1.0, 3), "rotated cube quads");
+  check_both_paths(morph::test::rotated_cube_triangles(1.0, 3), "rotated cube triangles");
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    check_both_paths(morph::test::random_sphere_polytope(60, seed),
+                     "sphere " + std::to_string(seed));
+    const Mesh integer = morph::test::random_integer_polytope(40, seed);
+    check_both_paths(integer, "integer " + std::to_string(seed));
+    check_both_paths(triangulated(integer), "triangulated integer " + std::to_string(seed));
+  }
+}
+
+TEST_CASE("polytope: coplanar triangles are merged into the facets of the polygon mesh") {
+  const Mesh integer = morph::test::random_integer_polytope(40, 5);
+  const Mesh triangles = triangulated(integer);
+  REQUIRE(triangles.n_faces() > integer.n_faces());
+  const Polytope merged = morph::detail::make_operand(triangles, "A");
+  const Polytope polygons = morph::detail::make_operand(integer, "A");
+  CHECK(merged.num_faces() == polygons.num_faces());
+  CHECK(merged.num_edges() == polygons.num_edges());
+  CHECK(merged.num_vertices() == polygons.num_vertices());
+  CHECK(labels_problem(merged, triangles, FaceOrder::as_given) == "");
+}
+
+TEST_CASE("polytope: a vertex in the middle of an edge is removed, its edge labelled") {
+  // The unit cube with vertex 8 halfway along the edge 0-1, in both faces at that edge.
+  std::vector<Point> points;
+  for (int i = 0; i < 8; ++i) points.push_back(Point(i & 1, (i >> 1) & 1, (i >> 2) & 1));
+  points.push_back(Point(0.5, 0, 0));
+  const Mesh mesh = morph::test::mesh_from_polygons(
+      points,
+      {{0, 2, 3, 1, 8}, {4, 5, 7, 6}, {0, 8, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}});
+  REQUIRE(morph::check_convex_polyhedron(mesh).ok());
+  const Polytope p = morph::detail::make_operand(mesh, "A");
+  CHECK(p.num_vertices() == 8);
+  CHECK(p.num_faces() == 6);
+  CHECK(p.num_edges() == 12);
+  CHECK(std::count(p.vertex_source.begin(), p.vertex_source.end(), 8) == 0);
+  CHECK(labels_problem(p, mesh, FaceOrder::as_given) == "");
+  check_both_paths(mesh, "cube with an edge midpoint");
+}
+
+TEST_CASE("polytope: labels name the live elements of a mesh with deleted ones") {
+  // A deleted vertex first, so that every live index is off by one from a dense count.
+  Mesh mesh;
+  const auto gone = mesh.add_vertex(Point(5, 5, 5));
+  std::vector<Mesh::VertexHandle> v;
+  for (int i = 0; i < 8; ++i)
+    v.push_back(mesh.add_vertex(Point(i & 1, (i >> 1) & 1, (i >> 2) & 1)));
+  for (const auto& q : std::vector<std::vector<int>>{
+           {0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}})
+    mesh.add_face({v[q[0]], v[q[1]], v[q[2]], v[q[3]]});
+  mesh.delete_vertex(gone);
+  REQUIRE(morph::check_convex_polyhedron(mesh).ok());
+  const Polytope p = morph::detail::make_operand(mesh, "A");
+  CHECK(p.num_vertices() == 8);
+  CHECK(p.num_faces() == 6);
+  CHECK(labels_problem(p, mesh, FaceOrder::as_given) == "");
+}
+
+TEST_CASE("polytope: make_operand keeps the messages of prepare_convex_polyhedron") {
+  const Mesh open = morph::test::mesh_from_polygons(morph::test::positions(morph::test::cube(2.0)),
+                                                    {{0, 1, 2}, {0, 2, 3}});
+  std::string expected;
+  try {
+    morph::prepare_convex_polyhedron(open, "A");
+  } catch (const morph::invalid_mesh& error) {
+    expected = error.what();
+  }
+  REQUIRE(!expected.empty());
+  try {
+    morph::detail::make_operand(open, "A");
+    FAIL("an open mesh was accepted");
+  } catch (const morph::invalid_mesh& error) {
+    CHECK(std::string(error.what()) == expected);
+  }
+}
