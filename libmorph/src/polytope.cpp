@@ -52,12 +52,21 @@ void Polytope::compute_normals() {
   const int nf = num_faces();
   normals.resize(nf);
   RoundingGuard guard;
-  std::vector<V3<Interval>> cycle;
-  for (int f = 0; f < nf; ++f) {
-    const int b = face_begin[f];
-    cycle.clear();
-    for (int k = 0; k < degree(f); ++k) cycle.push_back(interval_point(corner_vertex[b + k]));
-    normals[f] = newell_normal<Interval>(degree(f), [&](int i) -> const V3<Interval>& { return cycle[i]; });
+  if (exact_points.empty()) {
+    for (int f = 0; f < nf; ++f) {
+      const int* corners = &corner_vertex[face_begin[f]];
+      normals[f] = newell_normal<Interval>(degree(f),
+                                           [&](int i) { return to_interval(points[corners[i]]); });
+    }
+  } else {
+    std::vector<V3<Interval>> cycle;  // conversions from rationals are worth caching
+    for (int f = 0; f < nf; ++f) {
+      const int b = face_begin[f];
+      cycle.clear();
+      for (int k = 0; k < degree(f); ++k) cycle.push_back(interval_point(corner_vertex[b + k]));
+      normals[f] = newell_normal<Interval>(degree(f),
+                                           [&](int i) -> const V3<Interval>& { return cycle[i]; });
+    }
   }
   exact_cache_ = std::make_shared<ExactCache>(nf);
 }

@@ -115,12 +115,16 @@ Finding closed_manifold(const Mesh& mesh) {
                   "vertex " + std::to_string(v.idx()) + " is isolated (it belongs to no face)");
     int reached = 0;
     bool pinched = false;
-    for (auto h : mesh.voh_range(v)) {
+    // The outgoing halfedges around v, as the circulator walks them.
+    const auto first = mesh.halfedge_handle(v);
+    auto h = first;
+    do {
       const int w = mesh.to_vertex_handle(h).idx();
       pinched = pinched || seen[w] == v.idx();
       seen[w] = v.idx();
       if (++reached > outgoing[v.idx()]) break;  // corrupt links
-    }
+      h = mesh.next_halfedge_handle(mesh.opposite_halfedge_handle(h));
+    } while (h != first);
     if (reached != outgoing[v.idx()])
       return fail(Verdict::invalid, "vertex " + std::to_string(v.idx()) +
                                         " is not manifold: its faces form more than one fan");
@@ -197,7 +201,7 @@ FacePlane newell_plane(const std::vector<Point>& corners) {
   plane.centroid /= static_cast<double>(corners.size());
   for (std::size_t i = 0; i < corners.size(); ++i) {
     const Point a = corners[i] - plane.centroid;
-    const Point b = corners[(i + 1) % corners.size()] - plane.centroid;
+    const Point b = corners[i + 1 == corners.size() ? 0 : i + 1] - plane.centroid;
     plane.normal += OpenMesh::cross(a, b);
   }
   return plane;
