@@ -555,8 +555,10 @@ class IncrementalHull {
       }
     }
     // A horizon edge may have been recorded before its far triangle turned out visible.
-    std::erase_if(horizon,
-                  [&](const auto& h) { return !tris_[tris_[h.first].across[h.second]].alive; });
+    horizon.erase(std::remove_if(
+                      horizon.begin(), horizon.end(),
+                      [&](const auto& h) { return !tris_[tris_[h.first].across[h.second]].alive; }),
+                  horizon.end());
     // One new triangle (u, w, p) per horizon edge u -> w, linked around p.
     std::unordered_map<int, int> by_start, by_end;
     std::vector<int> created;
