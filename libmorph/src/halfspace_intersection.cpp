@@ -1,21 +1,35 @@
 // Exact half-space intersection by duality: with a point o strictly inside, the
 // half-space <n, x> <= d maps to the dual point n / (d - <n, o>); the facets of the
 // intersection are the dual points that are vertices of their convex hull, and its
-// vertices are the hull's facets. Coordinates stay exact rationals throughout.
+// vertices are the hull's facets.
+//
+// Fast route: the dual hull of the points rounded to doubles (CGAL, Epick), then an exact
+// check that its combinatorics are those of the exact hull (Mehlhorn et al., "Checking
+// geometric programs or verification of geometric structures", 1999): a closed
+// triangulated surface around o, locally convex at every edge, that a ray from o crosses
+// once, is the boundary of its convex hull; the hull holds every other dual point iff
+// its plane does not cut the candidate polytope, which a walk on the (convex) candidate
+// decides. All tests are on the planes as dyadic homogeneous coordinates (Mpzf, no gcd),
+// interval-filtered. If any test fails, the exact route computes the dual hull on exact
+// rational points (Epeck). Both routes end in the same exact, canonical construction.
 #include "halfspace_intersection.h"
 
-#include <morph/error.h>
-
-#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Lazy_kernel.h>
 #include <CGAL/QP_functions.h>
 #include <CGAL/QP_models.h>
+#include <CGAL/Quotient.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/convex_hull_3.h>
+#include <morph/error.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
+#include <cmath>
 #include <map>
 #include <numeric>
+#include <unordered_map>
 
 #include "gauss_map.h"
 #include "parallel.h"
@@ -24,12 +38,52 @@ namespace morph::detail {
 
 namespace {
 
-using Kernel = CGAL::Exact_predicates_exact_constructions_kernel;
-using HullMesh = CGAL::Surface_mesh<Kernel::Point_3>;
-
-Kernel::FT to_kernel(const Exact& q) { return Kernel::FT(mpq_class(q.mpq())); }
+using FastKernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+// Exact constructions on fractions of dyadic floats, never reduced: no gcd (CGAL's Epeck
+// normalises Gmpq after every operation, which dominated the erosion's profile).
+using ExactKernel = CGAL::Lazy_kernel<CGAL::Simple_cartesian<CGAL::Quotient<ExactN>>>;
 
 Exact abs_value(const Exact& x) { return x < 0 ? -x : x; }
+
+/// An integer as Mpzf (CGAL's Mpzf(Gmpz) drops the sign and mishandles zero).
+ExactN integer_n(const CGAL::Gmpz& z) {
+  if (CGAL::sign(z) == 0) return ExactN(0);
+  const ExactN magnitude(CGAL::abs(z));
+  return CGAL::sign(z) < 0 ? ExactN(0) - magnitude : magnitude;
+}
+
+Interval to_interval_n(const ExactN& x) { return Interval(x.to_interval()); }
+V3<Interval> to_interval_n(const V3<ExactN>& p) {
+  return {to_interval_n(p.x), to_interval_n(p.y), to_interval_n(p.z)};
+}
+
+/// A half-space as the homogeneous plane <n, x> <= d (the HalfSpace times its
+/// denominator, so both are dyadic), with interval copies for the filters.
+struct Plane {
+  V3<ExactN> n;
+  ExactN d;
+  V3<Interval> ni;
+  Interval di;
+};
+
+std::vector<Plane> planes_of(const std::vector<HalfSpace>& hs) {
+  std::vector<Plane> planes(hs.size());
+  parallel_chunks(static_cast<int>(hs.size()), 256, [&](int begin, int end) {
+    RoundingGuard guard;
+    for (int i = begin; i < end; ++i) {
+      Plane& p = planes[i];
+      const ExactN& q = hs[i].denominator;
+      p.n = q == 1 ? hs[i].normal
+                   : V3<ExactN>{hs[i].normal.x * q, hs[i].normal.y * q, hs[i].normal.z * q};
+      p.d = hs[i].offset;
+      p.ni = to_interval_n(p.n);
+      p.di = to_interval_n(p.d);
+    }
+  });
+  return planes;
+}
+
+Exact rational_offset(const HalfSpace& h) { return Exact(h.offset) / Exact(h.denominator); }
 
 /// Chebyshev-like centre for the L1 norm: maximise t subject to
 /// <n_i, x> + |n_i|_1 t <= d_i, t <= 1. t* > 0: a solid (x* strictly inside);
@@ -47,12 +101,13 @@ CentreResult exact_centre(const std::vector<HalfSpace>& hs) {
     lp.set_a(1, i, n.y);
     lp.set_a(2, i, n.z);
     lp.set_a(3, i, abs_value(n.x) + abs_value(n.y) + abs_value(n.z));
-    lp.set_b(i, hs[i].offset);
+    lp.set_b(i, rational_offset(hs[i]));
   }
   lp.set_u(3, true, Exact(1));
   lp.set_c(3, Exact(-1));
   const auto solution = CGAL::solve_linear_program(lp, Exact());
-  if (!solution.is_optimal()) throw error("internal error: the centre of an erosion could not be found");
+  if (!solution.is_optimal())
+    throw error("internal error: the centre of an erosion could not be found");
   std::vector<Exact> value;
   for (auto it = solution.variable_values_begin(); it != solution.variable_values_end(); ++it)
     value.push_back(it->numerator() / it->denominator());
@@ -60,28 +115,580 @@ CentreResult exact_centre(const std::vector<HalfSpace>& hs) {
 }
 
 /// o strictly inside every half-space? (interval filter, exact when undecided)
-bool strictly_inside(const std::vector<HalfSpace>& hs, const V3<Exact>& o) {
+bool strictly_inside(const std::vector<Plane>& planes, const V3<double>& o) {
   const V3<Interval> oi = to_interval(o);
   std::atomic<bool> inside = true;
-  parallel_chunks(static_cast<int>(hs.size()), 512, [&](int begin, int end) {
+  parallel_chunks(static_cast<int>(planes.size()), 512, [&](int begin, int end) {
     RoundingGuard guard;
+    const V3<ExactN> oe = to_exact_n(o);
     for (int i = begin; i < end && inside; ++i) {
-      const V3<ExactN>& ne = hs[i].normal;
-      const V3<Interval> n{Interval(ne.x.to_interval()), Interval(ne.y.to_interval()), Interval(ne.z.to_interval())};
-      int s = interval_sign(Interval(CGAL::to_interval(hs[i].offset)) - dot(n, oi));
-      if (s == 2) s = CGAL::sign(hs[i].offset - dot(to_rational(ne), o));
+      int s = interval_sign(planes[i].di - dot(planes[i].ni, oi));
+      if (s == 2) s = CGAL::sign(planes[i].d - dot(planes[i].n, oe));
       if (s <= 0) inside = false;
     }
   });
   return inside;
 }
 
+/// A candidate dual hull: triangles over plane indices, counter-clockwise seen from
+/// outside, and the triangle across each edge (edge k runs from corner k to corner k + 1).
+struct DualSurface {
+  std::vector<std::array<int, 3>> corner;
+  std::vector<std::array<int, 3>> across;
+};
+
+/// The triangles of a hull computed by CGAL; empty when it is not a closed triangulated
+/// sphere (the points were flat, or rounding made them so).
+template <class HullMesh, class IndexOf>
+DualSurface surface_of(const HullMesh& hull, const IndexOf& index_of) {
+  DualSurface s;
+  const auto nv = static_cast<long>(hull.number_of_vertices()),
+             ne = static_cast<long>(hull.number_of_edges()),
+             nf = static_cast<long>(hull.number_of_faces());
+  if (nf < 4 || nv - ne + nf != 2 || !CGAL::is_closed(hull) || !CGAL::is_triangle_mesh(hull))
+    return s;
+  s.corner.resize(nf);
+  s.across.resize(nf);
+  for (auto f : hull.faces()) {
+    auto h = hull.halfedge(f);
+    for (int k = 0; k < 3; ++k) {
+      s.corner[f.idx()][k] = index_of(hull.point(hull.target(h)));
+      h = hull.next(h);
+      s.across[f.idx()][k] = static_cast<int>(hull.face(hull.opposite(h)).idx());
+    }
+  }
+  return s;
+}
+
+/// A vertex of the intersection in homogeneous coordinates: X / W with W > 0.
+struct HVertex {
+  V3<ExactN> X;
+  ExactN W;
+  V3<Interval> Xi;
+  Interval Wi;
+  V3<Interval> xi;  // Xi / Wi
+};
+
+/// The point of three planes (Cramer's rule); W = det(n_a, n_b, n_c).
+template <class T>
+void meet(const V3<T>& na, const T& da, const V3<T>& nb, const T& db, const V3<T>& nc, const T& dc,
+          V3<T>& X, T& W) {
+  const V3<T> bc = cross(nb, nc), ca = cross(nc, na), ab = cross(na, nb);
+  W = dot(na, bc);
+  X = {da * bc.x + db * ca.x + dc * ab.x, da * bc.y + db * ca.y + dc * ab.y,
+       da * bc.z + db * ca.z + dc * ab.z};
+}
+
+/// The exact and interval vertex of three planes (needs a RoundingGuard).
+HVertex vertex_of(const Plane& a, const Plane& b, const Plane& c) {
+  HVertex v;
+  meet(a.n, a.d, b.n, b.d, c.n, c.d, v.X, v.W);
+  meet(a.ni, a.di, b.ni, b.di, c.ni, c.di, v.Xi, v.Wi);
+  v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
+  return v;
+}
+
+/// Sign of <n, x> - d at a vertex: > 0 when the vertex violates the half-space.
+int side(const Plane& p, const HVertex& v) {
+  const int s = interval_sign(dot(p.ni, v.Xi) - p.di * v.Wi);
+  return s != 2 ? s : CGAL::sign(dot(p.n, v.X) - p.d * v.W);
+}
+
+/// Sign of <n, u> - <n, v>.
+int compare_along(const Plane& p, const HVertex& u, const HVertex& v) {
+  const int s = interval_sign(dot(p.ni, u.xi) - dot(p.ni, v.xi));
+  return s != 2 ? s : CGAL::sign(dot(p.n, u.X) * v.W - dot(p.n, v.X) * u.W);
+}
+
+int det_sign(const Plane& a, const Plane& b, const Plane& c) {
+  const int s = interval_sign(det(a.ni, b.ni, c.ni));
+  return s != 2 ? s : CGAL::sign(det(a.n, b.n, c.n));
+}
+
+/// Builds the intersection from a candidate dual hull, checking exactly that it is the
+/// dual hull of all the planes; nullopt when it is not.
+std::optional<Polytope> build_verified(const std::vector<HalfSpace>& hs,
+                                       const std::vector<Plane>& planes, const DualSurface& s) {
+  const int nt = static_cast<int>(s.corner.size());
+  const int n = static_cast<int>(planes.size());
+  if (nt == 0) return std::nullopt;
+  // Every triangle sees o on its inner side: det(n_a, n_b, n_c) > 0 (dual points are the
+  // normals scaled by positive factors).
+  std::atomic<bool> ok = true;
+  parallel_chunks(nt, 512, [&](int begin, int end) {
+    RoundingGuard guard;
+    for (int t = begin; t < end && ok; ++t)
+      if (det_sign(planes[s.corner[t][0]], planes[s.corner[t][1]], planes[s.corner[t][2]]) <= 0)
+        ok = false;
+  });
+  if (!ok) return std::nullopt;
+  // A ray from o crosses exactly one triangle: through the inside of triangle 0, and
+  // strictly inside or outside every other one.
+  {
+    const auto& c0 = s.corner[0];
+    const V3<ExactN> r = planes[c0[0]].n + planes[c0[1]].n + planes[c0[2]].n;
+    std::atomic<int> hits = 0;
+    parallel_chunks(nt, 512, [&](int begin, int end) {
+      RoundingGuard guard;
+      const Plane ray{r, ExactN(0), to_interval_n(r), Interval(0)};
+      for (int t = begin; t < end && ok; ++t) {
+        const Plane &a = planes[s.corner[t][0]], &b = planes[s.corner[t][1]],
+                    &c = planes[s.corner[t][2]];
+        const int s0 = det_sign(ray, b, c);
+        if (s0 < 0) continue;
+        const int s1 = det_sign(a, ray, c);
+        if (s1 < 0) continue;
+        const int s2 = det_sign(a, b, ray);
+        if (s2 < 0) continue;
+        if (s0 == 0 || s1 == 0 || s2 == 0)
+          ok = false;  // on a boundary: undecided, let the exact route do it
+        else
+          ++hits;
+      }
+    });
+    if (!ok || hits != 1) return std::nullopt;
+  }
+  // Group triangles whose planes meet in one point (exactly coplanar dual triangles):
+  // each group is a vertex of the intersection. Every edge between groups must be
+  // strictly convex: the far plane of each neighbour is strictly satisfied.
+  std::vector<int> group(nt, -1), seed;
+  std::vector<HVertex> vertex;
+  {
+    RoundingGuard guard;
+    std::vector<int> stack;
+    for (int t0 = 0; t0 < nt; ++t0) {
+      if (group[t0] >= 0) continue;
+      const int g = static_cast<int>(seed.size());
+      seed.push_back(t0);
+      const auto& c = s.corner[t0];
+      vertex.push_back(vertex_of(planes[c[0]], planes[c[1]], planes[c[2]]));
+      group[t0] = g;
+      stack.assign(1, t0);
+      while (!stack.empty()) {
+        const int t = stack.back();
+        stack.pop_back();
+        for (int k = 0; k < 3; ++k) {
+          const int nb = s.across[t][k];
+          const auto& cn = s.corner[nb];
+          const int a = s.corner[t][k], b = s.corner[t][(k + 1) % 3];
+          int far = -1;
+          for (int j = 0; j < 3; ++j)
+            if (cn[j] != a && cn[j] != b) far = cn[j];
+          if (far < 0) return std::nullopt;
+          const int sd = side(planes[far], vertex[g]);
+          if (sd > 0) return std::nullopt;
+          if (sd < 0) continue;
+          if (group[nb] < 0) {
+            group[nb] = g;
+            stack.push_back(nb);
+          } else if (group[nb] != g) {
+            return std::nullopt;
+          }
+        }
+      }
+    }
+  }
+  const int nv = static_cast<int>(vertex.size());
+  // The vertex graph (edges between groups).
+  std::vector<int> adj_begin(nv + 1, 0), adj;
+  {
+    std::vector<std::pair<int, int>> links;
+    for (int t = 0; t < nt; ++t)
+      for (int k = 0; k < 3; ++k)
+        if (group[s.across[t][k]] != group[t]) links.emplace_back(group[t], group[s.across[t][k]]);
+    std::sort(links.begin(), links.end());
+    links.erase(std::unique(links.begin(), links.end()), links.end());
+    for (const auto& l : links) ++adj_begin[l.first + 1];
+    for (int v = 0; v < nv; ++v) adj_begin[v + 1] += adj_begin[v];
+    for (const auto& l : links) adj.push_back(l.second);
+  }
+  // Facets: dual vertices with at least three groups around them (others lie on a dual
+  // edge or facet: their planes only touch the intersection).
+  std::vector<int> some_triangle(n, -1);
+  for (int t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k) some_triangle[s.corner[t][k]] = t;
+  std::vector<std::vector<int>> faces;
+  std::vector<int> face_halfspace;
+  for (int p = 0; p < n; ++p) {
+    if (some_triangle[p] < 0) continue;
+    std::vector<int> cyc;
+    int t = some_triangle[p], steps = 0;
+    do {
+      const int g = group[t];
+      if (cyc.empty() || cyc.back() != g) cyc.push_back(g);
+      int k = 0;
+      while (k < 3 && s.corner[t][k] != p) ++k;
+      if (k == 3 || ++steps > nt) return std::nullopt;
+      t = s.across[t][k];
+    } while (t != some_triangle[p]);
+    while (cyc.size() > 1 && cyc.front() == cyc.back()) cyc.pop_back();
+    if (cyc.size() < 3) continue;
+    faces.push_back(std::move(cyc));
+    face_halfspace.push_back(p);
+  }
+  if (faces.size() < 4) return std::nullopt;
+  // The candidate is a convex polytope. Every plane that is not a dual vertex must not cut
+  // it: climb to its highest vertex (a local maximum is global on a convex polytope) and
+  // collect the vertices where it touches (sorted).
+  std::vector<int> others;
+  for (int p = 0; p < n; ++p)
+    if (some_triangle[p] < 0) others.push_back(p);
+  std::vector<std::vector<int>> touched(others.size());
+  parallel_chunks(static_cast<int>(others.size()), 64, [&](int begin, int end) {
+    RoundingGuard guard;
+    int u = 0;
+    for (int j = begin; j < end && ok; ++j) {
+      const Plane& p = planes[others[j]];
+      for (bool moved = true; moved;) {
+        moved = false;
+        for (int a = adj_begin[u]; a < adj_begin[u + 1]; ++a) {
+          if (compare_along(p, vertex[adj[a]], vertex[u]) > 0) {
+            u = adj[a];
+            moved = true;
+            break;
+          }
+        }
+      }
+      const int sd = side(p, vertex[u]);
+      if (sd > 0) ok = false;
+      if (sd != 0) continue;
+      std::vector<int>& plateau = touched[j];
+      plateau.push_back(u);
+      for (std::size_t q = 0; q < plateau.size(); ++q)
+        for (int a = adj_begin[plateau[q]]; a < adj_begin[plateau[q] + 1]; ++a)
+          if (std::find(plateau.begin(), plateau.end(), adj[a]) == plateau.end() &&
+              side(p, vertex[adj[a]]) == 0)
+            plateau.push_back(adj[a]);
+      std::sort(plateau.begin(), plateau.end());
+    }
+  });
+  if (!ok) return std::nullopt;
+  // Verified. The half-spaces through each vertex: those of its triangles and the
+  // touching ones. A touching plane along a whole facet is that facet's plane given twice:
+  // the facet takes the smaller index.
+  std::vector<std::vector<int>> key(nv);
+  for (int t = 0; t < nt; ++t)
+    key[group[t]].insert(key[group[t]].end(), s.corner[t].begin(), s.corner[t].end());
+  for (std::size_t j = 0; j < others.size(); ++j) {
+    for (int v : touched[j]) key[v].push_back(others[j]);
+    if (touched[j].size() < 3) continue;
+    for (std::size_t f = 0; f < faces.size(); ++f) {
+      std::vector<int> cyc = faces[f];
+      std::sort(cyc.begin(), cyc.end());
+      if (cyc == touched[j]) face_halfspace[f] = std::min(face_halfspace[f], others[j]);
+    }
+  }
+  for (auto& k : key) {
+    std::sort(k.begin(), k.end());
+    k.erase(std::unique(k.begin(), k.end()), k.end());
+  }
+  // Number vertices and facets canonically (hull orders depend on CGAL's internal
+  // shuffling): a vertex by the sorted half-spaces through it, a facet by its half-space,
+  // each cycle starting at its smallest vertex. The output then depends only on the input.
+  std::vector<int> order(nv), rank(nv);
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return key[a] < key[b]; });
+  for (int r = 0; r < nv; ++r) rank[order[r]] = r;
+  std::vector<int> forder(faces.size());
+  std::iota(forder.begin(), forder.end(), 0);
+  std::sort(forder.begin(), forder.end(),
+            [&](int a, int b) { return face_halfspace[a] < face_halfspace[b]; });
+  std::vector<std::vector<int>> sorted_faces;
+  std::vector<int> sorted_halfspace;
+  for (int f : forder) {
+    auto cyc = faces[f];
+    for (int& g : cyc) g = rank[g];
+    std::rotate(cyc.begin(), std::min_element(cyc.begin(), cyc.end()), cyc.end());
+    sorted_faces.push_back(std::move(cyc));
+    sorted_halfspace.push_back(face_halfspace[f]);
+  }
+  faces = std::move(sorted_faces);
+  face_halfspace = std::move(sorted_halfspace);
+  // Exact rational vertices, once each.
+  std::vector<V3<Exact>> exact(nv);
+  std::vector<V3<double>> rounded(nv);
+  parallel_chunks(nv, 128, [&](int begin, int end) {
+    for (int r = begin; r < end; ++r) {
+      const HVertex& v = vertex[order[r]];
+      const Exact w(v.W);
+      exact[r] = {Exact(v.X.x) / w, Exact(v.X.y) / w, Exact(v.X.z) / w};
+      rounded[r] = {round_to_nearest(exact[r].x), round_to_nearest(exact[r].y),
+                    round_to_nearest(exact[r].z)};
+    }
+  });
+  // Circulating around a dual vertex may run clockwise: orient by the first facet.
+  {
+    const auto& cyc = faces[0];
+    const V3<Exact> nw = newell_normal<Exact>(
+        static_cast<int>(cyc.size()), [&](int i) -> const V3<Exact>& { return exact[cyc[i]]; });
+    if (CGAL::sign(dot(nw, to_rational(hs[face_halfspace[0]].normal))) < 0)
+      for (auto& c : faces) std::reverse(c.begin(), c.end());
+  }
+  std::vector<V3<ExactN>> normals(faces.size());
+  for (std::size_t f = 0; f < faces.size(); ++f) normals[f] = hs[face_halfspace[f]].normal;
+  Polytope p =
+      make_polytope(std::move(rounded), std::move(exact), faces, std::move(normals), "A (-) B");
+  for (auto& src : p.face_source) src = hs[face_halfspace[src]].source;
+  return p;
+}
+
+/// The exact dual hull, built incrementally on the planes themselves: the dual point of a
+/// plane sees a dual triangle iff the plane cuts off the triangle's vertex (side > 0), an
+/// interval-filtered test on dyadic homogeneous coordinates, exact only when undecided.
+/// Randomised insertion order (fixed seed) with one conflict triangle per pending plane.
+/// Returns an empty surface when it meets an inconsistency; the caller verifies the result
+/// like any candidate.
+class IncrementalHull {
+ public:
+  explicit IncrementalHull(const std::vector<Plane>& planes) : planes_(planes) {}
+
+  /// `reach`: a bound on the distance from o to the intersection (checked: a virtual plane
+  /// left on the hull makes the run fail).
+  DualSurface run(const V3<double>& o, double reach) {
+    RoundingGuard guard;
+    const int n = static_cast<int>(planes_.size());
+    start(o, reach);
+    std::vector<int> order(n);
+    std::iota(order.begin(), order.end(), 0);
+    std::uint64_t state = 0x9e3779b97f4a7c15ull;  // fixed seed: the result must not vary
+    for (int i = n - 1; i > 0; --i) {
+      state = state * 6364136223846793005ull + 1442695040888963407ull;
+      std::swap(order[i],
+                order[static_cast<int>((state >> 33) % static_cast<std::uint64_t>(i + 1))]);
+    }
+    for (int p : order)
+      if (conflict_[p] >= 0 && !insert(p)) return {};
+    DualSurface s;
+    for (const Tri& t : tris_)
+      if (t.alive && std::max({t.c[0], t.c[1], t.c[2]}) >= n) return {};
+    std::vector<int> index(tris_.size(), -1);
+    for (std::size_t t = 0; t < tris_.size(); ++t)
+      if (tris_[t].alive)
+        index[t] = static_cast<int>(s.corner.size()), s.corner.push_back(tris_[t].c);
+    for (const Tri& t : tris_) {
+      if (!t.alive) continue;
+      s.across.push_back({index[t.across[0]], index[t.across[1]], index[t.across[2]]});
+    }
+    return s;
+  }
+
+ private:
+  struct Tri {
+    std::array<int, 3> c, across;
+    V3<Interval> Xi;
+    Interval Wi;
+    bool exact = false, alive = true;
+    V3<ExactN> X;
+    ExactN W;
+    std::vector<int> conflicts;
+  };
+
+  int add(int a, int b, int c) {
+    Tri t;
+    t.c = {a, b, c};
+    t.across = {-1, -1, -1};
+    meet(planes_[a].ni, planes_[a].di, planes_[b].ni, planes_[b].di, planes_[c].ni, planes_[c].di,
+         t.Xi, t.Wi);
+    tris_.push_back(std::move(t));
+    return static_cast<int>(tris_.size()) - 1;
+  }
+
+  int side_of(int p, int t) {
+    Tri& tri = tris_[t];
+    const Plane& h = planes_[p];
+    const int s = interval_sign(dot(h.ni, tri.Xi) - h.di * tri.Wi);
+    if (s != 2) return s;
+    if (!tri.exact) {
+      const Plane &a = planes_[tri.c[0]], &b = planes_[tri.c[1]], &c = planes_[tri.c[2]];
+      meet(a.n, a.d, b.n, b.d, c.n, c.d, tri.X, tri.W);
+      tri.exact = true;
+    }
+    return CGAL::sign(dot(h.n, tri.X) - h.d * tri.W);
+  }
+
+  // The start: four virtual planes, a regular tetrahedron around o reaching `reach`
+  // beyond it (their dual points lie deep inside the real hull when the tetrahedron
+  // holds the intersection), then every real plane's first conflict.
+  void start(const V3<double>& o, double reach) {
+    const int n = static_cast<int>(planes_.size());
+    const double dirs[4][3] = {{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}};
+    for (const auto& u : dirs) {
+      const V3<ExactN> m{ExactN(u[0]), ExactN(u[1]), ExactN(u[2])};
+      const ExactN d = dot(m, to_exact_n(o)) + ExactN(reach);
+      planes_.push_back({m, d, to_interval_n(m), to_interval_n(d)});
+    }
+    // Around vertex n + 3 (det of the other three normals > 0 in this order).
+    const int t0 = add(n, n + 1, n + 2), t1 = add(n + 1, n, n + 3), t2 = add(n + 2, n + 1, n + 3),
+              t3 = add(n, n + 2, n + 3);
+    tris_[t0].across = {t1, t2, t3};
+    tris_[t1].across = {t0, t3, t2};
+    tris_[t2].across = {t0, t1, t3};
+    tris_[t3].across = {t0, t2, t1};
+    conflict_.assign(n, -1);
+    for (int p = 0; p < n; ++p) {
+      for (int t = t0; t <= t3; ++t) {
+        if (side_of(p, t) > 0) {
+          conflict_[p] = t;
+          tris_[t].conflicts.push_back(p);
+          break;
+        }
+      }
+    }
+  }
+
+  bool insert(int p) {
+    // The visible triangles (connected), and the horizon around them.
+    std::vector<int> visible{conflict_[p]};
+    tris_[visible[0]].alive = false;
+    std::vector<std::pair<int, int>> horizon;  // (visible triangle, edge)
+    for (std::size_t q = 0; q < visible.size(); ++q) {
+      const int t = visible[q];
+      for (int k = 0; k < 3; ++k) {
+        const int nb = tris_[t].across[k];
+        if (!tris_[nb].alive) continue;
+        if (side_of(p, nb) > 0) {
+          tris_[nb].alive = false;
+          visible.push_back(nb);
+        } else {
+          horizon.emplace_back(t, k);
+        }
+      }
+    }
+    // A horizon edge may have been recorded before its far triangle turned out visible.
+    horizon.erase(std::remove_if(
+                      horizon.begin(), horizon.end(),
+                      [&](const auto& h) { return !tris_[tris_[h.first].across[h.second]].alive; }),
+                  horizon.end());
+    // One new triangle (u, w, p) per horizon edge u -> w, linked around p.
+    std::unordered_map<int, int> by_start, by_end;
+    std::vector<int> created;
+    for (const auto& [t, k] : horizon) {
+      const int u = tris_[t].c[k], w = tris_[t].c[(k + 1) % 3];
+      const int kept = tris_[t].across[k];
+      const int nt = add(u, w, p);
+      tris_[nt].across[0] = kept;
+      int j = 0;
+      while (j < 3 && tris_[kept].across[j] != t) ++j;
+      if (j == 3) return false;
+      tris_[kept].across[j] = nt;
+      if (!by_start.emplace(u, nt).second || !by_end.emplace(w, nt).second) return false;
+      created.push_back(nt);
+    }
+    for (int nt : created) {
+      const auto s_it = by_start.find(tris_[nt].c[1]), e_it = by_end.find(tris_[nt].c[0]);
+      if (s_it == by_start.end() || e_it == by_end.end()) return false;
+      tris_[nt].across[1] = s_it->second;
+      tris_[nt].across[2] = e_it->second;
+    }
+    // Pending planes of the removed triangles look for a new one they see.
+    for (int t : visible) {
+      for (int q : tris_[t].conflicts) {
+        if (q == p) continue;
+        conflict_[q] = -1;
+        for (int nt : created) {
+          if (side_of(q, nt) > 0) {
+            conflict_[q] = nt;
+            break;
+          }
+        }
+        if (conflict_[q] < 0) {
+          for (int s = 0; s < static_cast<int>(tris_.size()); ++s) {
+            if (tris_[s].alive && side_of(q, s) > 0) {
+              conflict_[q] = s;
+              break;
+            }
+          }
+        }
+        if (conflict_[q] >= 0) tris_[conflict_[q]].conflicts.push_back(q);
+      }
+      std::vector<int>().swap(tris_[t].conflicts);
+    }
+    conflict_[p] = -1;
+    return true;
+  }
+
+  std::vector<Plane> planes_;  // and the virtual ones
+  std::vector<Tri> tris_;
+  std::vector<int> conflict_;
+};
+
+/// A power of two well beyond the distance from o to the vertices of a candidate hull.
+double reach(const std::vector<Plane>& planes, const DualSurface& guess, const V3<double>& o) {
+  const auto approx = [&](int i) {
+    return V3<double>{planes[i].n.x.to_double(), planes[i].n.y.to_double(),
+                      planes[i].n.z.to_double()};
+  };
+  double r = 1.0;
+  for (const auto& c : guess.corner) {
+    V3<double> x;
+    double w;
+    meet(approx(c[0]), planes[c[0]].d.to_double(), approx(c[1]), planes[c[1]].d.to_double(),
+         approx(c[2]), planes[c[2]].d.to_double(), x, w);
+    const double dist = std::abs(x.x / w - o.x) + std::abs(x.y / w - o.y) + std::abs(x.z / w - o.z);
+    if (std::isfinite(dist)) r = std::max(r, dist);
+  }
+  return std::ldexp(1.0, std::ilogb(r) + 4);
+}
+
+/// The dual hull of the points rounded to doubles (about o rounded to doubles).
+DualSurface double_dual_hull(const std::vector<Plane>& planes, const V3<double>& o) {
+  using Point = FastKernel::Point_3;
+  const int n = static_cast<int>(planes.size());
+  std::vector<Point> points(n);
+  std::map<Point, int> index_of;
+  for (int i = 0; i < n; ++i) {
+    const V3<double> nd{planes[i].n.x.to_double(), planes[i].n.y.to_double(),
+                        planes[i].n.z.to_double()};
+    const double w = planes[i].d.to_double() - dot(nd, o);
+    const Point y(nd.x / w, nd.y / w, nd.z / w);
+    if (!(w > 0) || !std::isfinite(y.x()) || !std::isfinite(y.y()) || !std::isfinite(y.z()))
+      return {};
+    points[i] = y;
+    index_of.emplace(y, i);
+  }
+  CGAL::Surface_mesh<Point> hull;
+  CGAL::convex_hull_3(points.begin(), points.end(), hull);
+  return surface_of(hull, [&](const Point& y) { return index_of.at(y); });
+}
+
+/// The dual hull of the exact dual points about o: n / (d - <n, o>), with o = p / q
+/// (q an integer) written as q n / (q d - <n, p>).
+DualSurface exact_dual_hull(const std::vector<Plane>& planes, const V3<Exact>& o) {
+  using Point = ExactKernel::Point_3;
+  using FT = ExactKernel::FT;
+  using Q = CGAL::Quotient<ExactN>;
+  const Exact q = Exact(o.x.denominator()) * Exact(o.y.denominator()) * Exact(o.z.denominator());
+  const ExactN qn = integer_n(q.numerator());
+  const V3<Exact> po{o.x * q, o.y * q, o.z * q};
+  const V3<ExactN> p{integer_n(po.x.numerator()), integer_n(po.y.numerator()),
+                     integer_n(po.z.numerator())};
+  const int n = static_cast<int>(planes.size());
+  std::vector<Point> points(n);
+  std::map<Point, int> index_of;
+  for (int i = 0; i < n; ++i) {
+    const Plane& h = planes[i];
+    const ExactN w = qn * h.d - dot(h.n, p);
+    points[i] = Point(FT(Q(qn * h.n.x, w)), FT(Q(qn * h.n.y, w)), FT(Q(qn * h.n.z, w)));
+    index_of.emplace(points[i], i);
+  }
+  CGAL::Surface_mesh<Point> hull;
+  CGAL::convex_hull_3(points.begin(), points.end(), hull);
+  return surface_of(hull, [&](const Point& y) { return index_of.at(y); });
+}
+
 }  // namespace
 
-MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<double>& hint) {
+HalfSpace make_halfspace(const V3<ExactN>& normal, const Exact& offset, int source) {
+  return {normal, integer_n(offset.numerator()), integer_n(offset.denominator()), source};
+}
+
+MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<double>& hint,
+                                   const IntersectOptions& options) {
   MaybePolytope out;
+  const std::vector<Plane> planes = planes_of(hs);
   V3<Exact> o = to_exact(hint);
-  if (!strictly_inside(hs, o)) {
+  V3<double> o_double = hint;
+  if (!strictly_inside(planes, hint)) {
     const CentreResult c = exact_centre(hs);
     if (c.t < 0) {
       out.reason = EmptyReason::empty;
@@ -90,134 +697,34 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
     }
     if (c.t == 0) {
       out.reason = EmptyReason::flat;
-      out.message = "the structuring element fits only on a plane, a segment or a point: the erosion has no interior";
+      out.message =
+          "the structuring element fits only on a plane, a segment or a point: the erosion has no "
+          "interior";
       return out;
     }
     o = c.x;
+    o_double = {round_to_nearest(o.x), round_to_nearest(o.y), round_to_nearest(o.z)};
   }
-  // Dual points, exact; their hull with CGAL's exact kernel.
-  const int n = static_cast<int>(hs.size());
-  std::vector<V3<Exact>> dual(n);
-  std::vector<Kernel::Point_3> points(n);
-  std::map<Kernel::Point_3, int> index_of;
-  for (int i = 0; i < n; ++i) {
-    const V3<Exact> nr = to_rational(hs[i].normal);
-    const Exact den = hs[i].offset - dot(nr, o);
-    dual[i] = {nr.x / den, nr.y / den, nr.z / den};
-    points[i] = Kernel::Point_3(to_kernel(dual[i].x), to_kernel(dual[i].y), to_kernel(dual[i].z));
-    index_of.emplace(points[i], i);
-  }
-  HullMesh hull;
-  CGAL::convex_hull_3(points.begin(), points.end(), hull);
-  // Group coplanar adjacent hull triangles: each group is a vertex of the intersection.
-  std::map<HullMesh::Face_index, int> group;
-  std::vector<std::vector<HullMesh::Face_index>> groups;
-  for (auto f : hull.faces()) {
-    if (group.count(f)) continue;
-    const int g = static_cast<int>(groups.size());
-    groups.emplace_back();
-    std::vector<HullMesh::Face_index> stack{f};
-    group[f] = g;
-    const auto h0 = hull.halfedge(f);
-    const auto& p0 = hull.point(hull.source(h0));
-    const auto& p1 = hull.point(hull.target(h0));
-    const auto& p2 = hull.point(hull.target(hull.next(h0)));
-    while (!stack.empty()) {
-      const auto cur = stack.back();
-      stack.pop_back();
-      groups[g].push_back(cur);
-      for (auto h : CGAL::halfedges_around_face(hull.halfedge(cur), hull)) {
-        const auto nb = hull.face(hull.opposite(h));
-        if (group.count(nb)) continue;
-        const auto& q = hull.point(hull.target(hull.next(hull.opposite(h))));
-        if (CGAL::coplanar(p0, p1, p2, q)) {
-          group[nb] = g;
-          stack.push_back(nb);
-        }
-      }
+  // The verification does not depend on o: any exact interior point (there is one) makes
+  // the duality argument hold, so the rounded o only has to give good double points.
+  if (options.try_doubles) {
+    const DualSurface guess = double_dual_hull(planes, o_double);
+    if (auto p = build_verified(hs, planes, guess)) {
+      out.polytope = std::move(p);
+      out.route = HullRoute::verified;
+      return out;
+    }
+    if (auto p = build_verified(
+            hs, planes, IncrementalHull(planes).run(o_double, reach(planes, guess, o_double)))) {
+      out.polytope = std::move(p);
+      out.route = HullRoute::incremental;
+      return out;
     }
   }
-  // The vertex of each group: x = o + w with <w, y> = 1 on the group's plane.
-  std::vector<V3<Exact>> vertex(groups.size());
-  for (std::size_t g = 0; g < groups.size(); ++g) {
-    const auto h = hull.halfedge(groups[g][0]);
-    const int i0 = index_of.at(hull.point(hull.source(h)));
-    const int i1 = index_of.at(hull.point(hull.target(h)));
-    const int i2 = index_of.at(hull.point(hull.target(hull.next(h))));
-    const V3<Exact> nrm = cross(dual[i1] - dual[i0], dual[i2] - dual[i0]);
-    const Exact k = dot(nrm, dual[i0]);
-    vertex[g] = {o.x + nrm.x / k, o.y + nrm.y / k, o.z + nrm.z / k};
-  }
-  // Facets: dual hull vertices with at least three groups around them (others lie on a
-  // hull edge or facet: their planes only touch the intersection).
-  std::vector<std::vector<int>> faces;
-  std::vector<int> face_source, face_halfspace;
-  for (auto v : hull.vertices()) {
-    std::vector<int> cyc;
-    for (auto f : CGAL::faces_around_target(hull.halfedge(v), hull)) {
-      const int g = group.at(f);
-      if (cyc.empty() || cyc.back() != g) cyc.push_back(g);
-    }
-    while (cyc.size() > 1 && cyc.front() == cyc.back()) cyc.pop_back();
-    if (cyc.size() < 3) continue;
-    faces.push_back(std::move(cyc));
-    face_halfspace.push_back(index_of.at(hull.point(v)));
-    face_source.push_back(hs[face_halfspace.back()].source);
-  }
-  if (faces.empty()) throw error("internal error: an intersection of half-spaces has no facets");
-  // Number vertices and facets canonically (CGAL's hull order depends on its internal
-  // shuffling): a vertex by the sorted half-spaces through it, a facet by its half-space,
-  // each cycle starting at its smallest vertex. The output then depends only on the input.
-  {
-    std::vector<std::vector<int>> key(groups.size());
-    for (std::size_t g = 0; g < groups.size(); ++g) {
-      for (auto f : groups[g])
-        for (auto v : CGAL::vertices_around_face(hull.halfedge(f), hull)) key[g].push_back(index_of.at(hull.point(v)));
-      std::sort(key[g].begin(), key[g].end());
-      key[g].erase(std::unique(key[g].begin(), key[g].end()), key[g].end());
-    }
-    std::vector<int> order(groups.size()), rank(groups.size());
-    std::iota(order.begin(), order.end(), 0);
-    std::sort(order.begin(), order.end(), [&](int a, int b) { return key[a] < key[b]; });
-    std::vector<V3<Exact>> sorted_vertex(groups.size());
-    for (std::size_t r = 0; r < order.size(); ++r) {
-      rank[order[r]] = static_cast<int>(r);
-      sorted_vertex[r] = vertex[order[r]];
-    }
-    vertex = std::move(sorted_vertex);
-    std::vector<int> forder(faces.size());
-    std::iota(forder.begin(), forder.end(), 0);
-    std::sort(forder.begin(), forder.end(), [&](int a, int b) { return face_halfspace[a] < face_halfspace[b]; });
-    std::vector<std::vector<int>> sorted_faces;
-    std::vector<int> sorted_source, sorted_halfspace;
-    for (int f : forder) {
-      auto cyc = faces[f];
-      for (int& g : cyc) g = rank[g];
-      std::rotate(cyc.begin(), std::min_element(cyc.begin(), cyc.end()), cyc.end());
-      sorted_faces.push_back(std::move(cyc));
-      sorted_source.push_back(face_source[f]);
-      sorted_halfspace.push_back(face_halfspace[f]);
-    }
-    faces = std::move(sorted_faces);
-    face_source = std::move(sorted_source);
-    face_halfspace = std::move(sorted_halfspace);
-  }
-  // Circulating around a hull vertex may run clockwise: orient by the first facet.
-  {
-    const auto& cyc = faces[0];
-    const V3<Exact> nw = newell_normal<Exact>(static_cast<int>(cyc.size()),
-                                              [&](int i) -> const V3<Exact>& { return vertex[cyc[i]]; });
-    if (CGAL::sign(dot(nw, to_rational(hs[face_halfspace[0]].normal))) < 0)
-      for (auto& c : faces) std::reverse(c.begin(), c.end());
-  }
-  std::vector<V3<double>> rounded(vertex.size());
-  for (std::size_t v = 0; v < vertex.size(); ++v)
-    rounded[v] = {round_to_nearest(vertex[v].x), round_to_nearest(vertex[v].y), round_to_nearest(vertex[v].z)};
-  std::vector<V3<ExactN>> normals(faces.size());
-  for (std::size_t f = 0; f < faces.size(); ++f) normals[f] = hs[face_halfspace[f]].normal;
-  Polytope p = make_polytope(std::move(rounded), std::move(vertex), faces, std::move(normals), "A (-) B");
-  for (auto& s : p.face_source) s = face_source[s];
-  out.polytope = std::move(p);
+  out.polytope = build_verified(hs, planes, exact_dual_hull(planes, o));
+  if (!out.polytope)
+    throw error("internal error: the exact dual hull of an erosion failed its own check");
+  out.route = HullRoute::exact;
   return out;
 }
 
@@ -225,12 +732,24 @@ MaybePolytope erode_polytope(const Polytope& A, const Polytope& B) {
   const std::vector<Location> loc = locate_all(A, B);
   const int nf = A.num_faces();
   std::vector<HalfSpace> hs(nf);
+  const bool dyadic = A.exact_points.empty() && B.exact_points.empty();
   parallel_chunks(nf, 64, [&](int begin, int end) {
     for (int f = begin; f < end; ++f) {
-      const V3<Exact> n = to_rational(A.exact_normal(f));
-      Exact offset = dot(n, A.exact_point(A.corner(f, 0)));
-      for (int k = 1; k < A.degree(f); ++k) offset = std::max(offset, dot(n, A.exact_point(A.corner(f, k))));
-      hs[f] = {A.exact_normal(f), offset - dot(n, B.exact_point(location_vertex(B, loc[f]))), A.face_source[f]};
+      const V3<ExactN>& n = A.exact_normal(f);
+      const int b = location_vertex(B, loc[f]);
+      if (dyadic) {
+        // Double points: every product is exact in Mpzf, no rationals needed.
+        ExactN offset = dot(n, to_exact_n(A.points[A.corner(f, 0)]));
+        for (int k = 1; k < A.degree(f); ++k)
+          offset = std::max(offset, dot(n, to_exact_n(A.points[A.corner(f, k)])));
+        hs[f] = {n, offset - dot(n, to_exact_n(B.points[b])), ExactN(1), A.face_source[f]};
+      } else {
+        const V3<Exact> nr = to_rational(n);
+        Exact offset = dot(nr, A.exact_point(A.corner(f, 0)));
+        for (int k = 1; k < A.degree(f); ++k)
+          offset = std::max(offset, dot(nr, A.exact_point(A.corner(f, k))));
+        hs[f] = make_halfspace(n, offset - dot(nr, B.exact_point(b)), A.face_source[f]);
+      }
     }
   });
   // A point usually inside: A's vertex centroid minus B's.
@@ -238,7 +757,8 @@ MaybePolytope erode_polytope(const Polytope& A, const Polytope& B) {
   for (const auto& p : A.points) ca = ca + p;
   for (const auto& p : B.points) cb = cb + p;
   const double ka = 1.0 / A.num_vertices(), kb = 1.0 / B.num_vertices();
-  return intersect_halfspaces(hs, {ca.x * ka - cb.x * kb, ca.y * ka - cb.y * kb, ca.z * ka - cb.z * kb});
+  return intersect_halfspaces(
+      hs, {ca.x * ka - cb.x * kb, ca.y * ka - cb.y * kb, ca.z * ka - cb.z * kb});
 }
 
 }  // namespace morph::detail

@@ -12,12 +12,26 @@
 
 namespace morph::detail {
 
-/// A closed half-space { x : <normal, x> <= offset }, exact. `source` is a facet index
-/// carried to the result's facet labels.
+/// A closed half-space { x : <normal, x> <= offset / denominator }, exact. Dyadic offsets
+/// (polytopes with double or dyadic points) have denominator 1; a rational offset p/q is
+/// stored as offset p, denominator q. `source` is a facet index carried to the result's
+/// facet labels.
 struct HalfSpace {
-  V3<ExactN> normal;  // dyadic: a facet normal of a polytope with double points
-  Exact offset;
+  V3<ExactN> normal;  // dyadic: a facet normal of a polytope; becomes the result facet's normal
+  ExactN offset;
+  ExactN denominator = ExactN(1);  // positive
   int source = -1;
+};
+
+/// The half-space <normal, x> <= offset for any rational offset.
+HalfSpace make_halfspace(const V3<ExactN>& normal, const Exact& offset, int source);
+
+/// Which hull gave an intersection (for tests and profiling).
+enum class HullRoute : unsigned char {
+  none,         // empty or flat: no hull
+  verified,     // the dual hull in doubles, verified exactly
+  incremental,  // the double hull failed its check: an exact incremental hull on the planes
+  exact,        // CGAL's hull of the exact dual points (both failed, or were not tried)
 };
 
 /// A polytope, or why there is none.
@@ -25,12 +39,21 @@ struct MaybePolytope {
   std::optional<Polytope> polytope;
   EmptyReason reason = EmptyReason::none;
   std::string message;
+  HullRoute route = HullRoute::none;
+};
+
+/// Options of intersect_halfspaces.
+struct IntersectOptions {
+  bool try_doubles = true;  // false: go straight to the exact hull (tests compare the routes)
 };
 
 /// The intersection of bounded half-spaces (their normals must positively span space).
 /// `hint` is a point that is often strictly inside (checked exactly; an exact linear
 /// program finds one otherwise). Empty or flat intersections are reported, not thrown.
-MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& halfspaces, const V3<double>& hint);
+/// The result is exact and canonical (numbered by the half-spaces through each vertex),
+/// whichever route computed it. Expected O(n log n) for n half-spaces.
+MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& halfspaces, const V3<double>& hint,
+                                   const IntersectOptions& options = {});
 
 /// A (-) B = intersection over facets f of A of { x : <N_f, x> <= h_A(N_f) - h_B(N_f) }.
 MaybePolytope erode_polytope(const Polytope& A, const Polytope& B);

@@ -1,0 +1,171 @@
+// The exact half-space intersection behind erosion (libmorph/src/halfspace_intersection.h):
+// its fast route (a dual hull in doubles, verified exactly) and its fallbacks must give
+// exactly the result of the exact route, on inputs chosen so that doubles get the
+// combinatorics wrong: nearly coincident planes, planes cutting a vertex by less than an
+// ulp, many planes through one vertex, duplicate planes, rational offsets.
+#include "halfspace_intersection.h"
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace morph::detail;
+
+HalfSpace plane(double nx, double ny, double nz, const Exact& offset, int source) {
+  return make_halfspace({ExactN(nx), ExactN(ny), ExactN(nz)}, offset, source);
+}
+
+/// The six planes of the cube [-r, r]^3.
+std::vector<HalfSpace> cube_planes(double r) {
+  std::vector<HalfSpace> hs;
+  const double axes[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  for (const auto& a : axes)
+    hs.push_back(plane(a[0], a[1], a[2], Exact(r), static_cast<int>(hs.size())));
+  return hs;
+}
+
+/// First difference between two results (exact positions, facet cycles, labels), or "".
+std::string difference(const MaybePolytope& got, const MaybePolytope& want) {
+  if (got.reason != want.reason) return "different emptiness";
+  if (!got.polytope || !want.polytope)
+    return got.polytope || want.polytope ? "one result missing" : "";
+  const Polytope &a = *got.polytope, &b = *want.polytope;
+  if (a.num_vertices() != b.num_vertices()) return "vertex counts differ";
+  for (int v = 0; v < a.num_vertices(); ++v) {
+    const V3<Exact> p = a.exact_point(v), q = b.exact_point(v);
+    if (p.x != q.x || p.y != q.y || p.z != q.z) return "vertex " + std::to_string(v) + " differs";
+  }
+  if (a.face_begin != b.face_begin || a.corner_vertex != b.corner_vertex) return "facets differ";
+  if (a.face_source != b.face_source) return "facet labels differ";
+  return "";
+}
+
+/// The intersection by the default (fast) route, checked against the exact route.
+MaybePolytope checked(const std::vector<HalfSpace>& hs, const V3<double>& hint = {0, 0, 0}) {
+  MaybePolytope fast = intersect_halfspaces(hs, hint);
+  const MaybePolytope exact = intersect_halfspaces(hs, hint, {.try_doubles = false});
+  CHECK(exact.route != HullRoute::verified);
+  CHECK(difference(fast, exact) == "");
+  return fast;
+}
+
+}  // namespace
+
+TEST_CASE("halfspace_intersection: a cube is found by the verified double hull") {
+  const MaybePolytope r = checked(cube_planes(1.0));
+  REQUIRE(r.polytope);
+  CHECK(r.route == HullRoute::verified);
+  CHECK(r.polytope->num_faces() == 6);
+  CHECK(r.polytope->num_vertices() == 8);
+}
+
+// A corner of the cube cut off by 2^-60: in doubles the cutting plane's dual point lies on
+// the hull, so the double hull misses the facet. Without the exact verification the
+// result would have 6 facets.
+TEST_CASE("halfspace_intersection: a cut below double resolution is caught and redone exactly") {
+  std::vector<HalfSpace> hs = cube_planes(1.0);
+  hs.push_back(plane(1, 1, 1, Exact(3) - Exact(std::ldexp(1.0, -60)), 6));
+  const MaybePolytope r = checked(hs);
+  REQUIRE(r.polytope);
+  CHECK(r.route != HullRoute::verified);
+  CHECK(r.polytope->num_faces() == 7);
+  CHECK(r.polytope->num_vertices() == 10);
+}
+
+// Vertices of degree 4 (the octahedron), also with a rational (non-dyadic) offset, and
+// a square pyramid whose apex has degree 4.
+TEST_CASE("halfspace_intersection: planes through one vertex are grouped exactly") {
+  for (const Exact offset : {Exact(1), Exact(1) / Exact(3)}) {
+    std::vector<HalfSpace> hs;
+    for (int s = 0; s < 8; ++s)
+      hs.push_back(plane(s & 1 ? -1 : 1, s & 2 ? -1 : 1, s & 4 ? -1 : 1, offset, s));
+    const MaybePolytope r = checked(hs);
+    REQUIRE(r.polytope);
+    CHECK(r.polytope->num_faces() == 8);
+    CHECK(r.polytope->num_vertices() == 6);
+  }
+  std::vector<HalfSpace> pyramid = {plane(0, 0, -1, Exact(1), 0), plane(1, 0, 1, Exact(1), 1),
+                                    plane(-1, 0, 1, Exact(1), 2), plane(0, 1, 1, Exact(1), 3),
+                                    plane(0, -1, 1, Exact(1), 4)};
+  const MaybePolytope r = checked(pyramid);
+  REQUIRE(r.polytope);
+  CHECK(r.polytope->num_faces() == 5);
+  CHECK(r.polytope->num_vertices() == 5);
+}
+
+// Many planes exactly through one rational point (not a double): in doubles their dual
+// points are not coplanar, exactly they are. The apex must come out as one exact vertex.
+TEST_CASE("halfspace_intersection: many planes through a rational apex") {
+  const V3<Exact> apex{Exact(1) / Exact(3), Exact(1) / Exact(5), Exact(1) / Exact(7)};
+  for (int k : {5, 12, 40}) {
+    std::vector<HalfSpace> hs = cube_planes(2.0);
+    for (int i = 0; i < k; ++i) {
+      const double t = 2 * M_PI * i / k;
+      const V3<double> n{std::cos(t), std::sin(t), 0.75};
+      hs.push_back(
+          make_halfspace(to_exact_n(n), dot(to_exact(n), apex), static_cast<int>(hs.size())));
+    }
+    const MaybePolytope r = checked(hs);
+    REQUIRE(r.polytope);
+    int found = 0;
+    for (int v = 0; v < r.polytope->num_vertices(); ++v) {
+      const V3<Exact> p = r.polytope->exact_point(v);
+      found += p.x == apex.x && p.y == apex.y && p.z == apex.z;
+    }
+    CHECK(found == 1);
+  }
+}
+
+// Nearly coincident planes: tangent planes of the unit sphere around the north pole,
+// slightly tilted and moved by less than an ulp of their offsets, so that rounding the
+// offsets changes the combinatorics. Some of these must defeat the double hull (so the
+// fallback runs), and every one must agree with the exact route.
+TEST_CASE("halfspace_intersection: nearly coincident planes") {
+  int fallbacks = 0;
+  for (int seed = 0; seed < 12; ++seed) {
+    std::vector<HalfSpace> hs = cube_planes(2.0);
+    hs[4] = plane(0, 0, 1, Exact(4), 4);  // room above the cap
+    for (int i = 0; i < 30; ++i) {
+      const double t = 2 * M_PI * ((i * 7 + seed * 3) % 30) / 30.0;
+      const double tilt = std::ldexp(1.0 + (i % 5) / 8.0, -24 - (i + seed) % 4);
+      const Exact move = Exact(std::ldexp(static_cast<double>((i * 13 + seed) % 7) - 3.0, -62));
+      hs.push_back(plane(tilt * std::cos(t), tilt * std::sin(t), 1, Exact(1) + move,
+                         static_cast<int>(hs.size())));
+    }
+    const MaybePolytope r = checked(hs);
+    REQUIRE(r.polytope);
+    fallbacks += r.route != HullRoute::verified;
+  }
+  CHECK(fallbacks > 0);
+}
+
+// The same plane twice (scaled by 3, with a later index): the facet keeps the smaller
+// index, whichever route finds it.
+TEST_CASE("halfspace_intersection: a duplicate plane labels its facet by the first index") {
+  std::vector<HalfSpace> hs = cube_planes(1.0);
+  hs.push_back(plane(3, 0, 0, Exact(3), 6));
+  hs.insert(hs.begin(), plane(0, 0, 3, Exact(3), -7));  // duplicate of +z, first
+  for (int i = 0; i < static_cast<int>(hs.size()); ++i) hs[i].source = i;
+  const MaybePolytope r = checked(hs);
+  REQUIRE(r.polytope);
+  CHECK(r.polytope->num_faces() == 6);
+  std::vector<int> labels = r.polytope->face_source;
+  std::sort(labels.begin(), labels.end());
+  CHECK(labels == std::vector<int>{0, 1, 2, 3, 4, 6});  // +z is half-space 0, not 5; +x is 1, not 7
+}
+
+TEST_CASE("halfspace_intersection: empty and flat intersections") {
+  std::vector<HalfSpace> hs = cube_planes(1.0);
+  hs.push_back(plane(1, 0, 0, Exact(-2), 6));
+  CHECK(intersect_halfspaces(hs, {0, 0, 0}).reason == morph::EmptyReason::empty);
+  hs.back() = plane(1, 0, 0, Exact(-1), 6);
+  CHECK(intersect_halfspaces(hs, {0, 0, 0}).reason == morph::EmptyReason::flat);
+  // A hint outside: the exact centre is found, then the fast route runs about it.
+  const MaybePolytope r = checked(cube_planes(1.0), {5, 5, 5});
+  REQUIRE(r.polytope);
+  CHECK(r.polytope->num_vertices() == 8);
+}
