@@ -1,8 +1,19 @@
 // The last step of every operation: from an exact result (facet cycles over rounded
 // points) to a clean mesh, merging features below double precision.
+//
+// Three passes, each linear in the size of the result:
+//   1. corners of a facet closer than the feature size are merged (clusters);
+//   2. adjacent facets that are coplanar to within the feature size are grouped, and a
+//      facet thinner than the feature size (a needle: two nearly parallel edges of the
+//      operands summed) joins a neighbour it is flat against;
+//   3. each group becomes one polygon (its boundary), and vertices left with fewer than
+//      three groups around them (inside a merged facet or in the middle of an edge) go.
+// When the facets no longer describe a closed manifold after pass 1 or a merged polygon
+// is not convex to within the feature size, the mesh is rebuilt instead from the convex
+// hull of the points (exact predicates), whose triangles go through passes 2 and 3.
 #include <morph/error.h>
 
-#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/convex_hull_3.h>
 
@@ -10,8 +21,8 @@
 #include <cmath>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <set>
-#include <tuple>
 
 #include "fims.h"
 
@@ -19,107 +30,359 @@ namespace morph::detail {
 
 namespace {
 
-using Kernel = CGAL::Exact_predicates_exact_constructions_kernel;
-using HullMesh = CGAL::Surface_mesh<Kernel::Point_3>;
+/// Polygons over point indices, with the result facet each came from (-1: none).
+struct Soup {
+  std::vector<int> begin{0};
+  std::vector<int> vertex;
+  std::vector<int> source;
+  int size() const { return static_cast<int>(begin.size()) - 1; }
+  int degree(int f) const { return begin[f + 1] - begin[f]; }
+  void add(const std::vector<int>& cycle, int src) {
+    vertex.insert(vertex.end(), cycle.begin(), cycle.end());
+    begin.push_back(static_cast<int>(vertex.size()));
+    source.push_back(src);
+  }
+};
 
-/// Builds `mesh` from the facet cycles over clusters; false (mesh untouched) when they no
-/// longer describe a closed manifold, and the hull route must be taken.
-bool build_direct(const std::vector<V3<double>>& points, const std::vector<int>& face_begin,
-                  const std::vector<int>& corners, const std::vector<int>& rep, Mesh& mesh,
-                  std::vector<int>* source) {
-  const int n = static_cast<int>(points.size());
-  const int nf = static_cast<int>(face_begin.size()) - 1;
-  std::vector<std::vector<int>> faces(nf);
-  std::vector<char> used(n, 0);
-  std::set<std::pair<int, int>> directed;
-  for (int f = 0; f < nf; ++f) {
-    auto& cyc = faces[f];
-    for (int c = face_begin[f]; c < face_begin[f + 1]; ++c) {
-      const int v = rep[corners[c]];
-      if (cyc.empty() || cyc.back() != v) cyc.push_back(v);
-    }
-    while (cyc.size() > 1 && cyc.front() == cyc.back()) cyc.pop_back();
-    std::vector<int> sorted = cyc;
-    std::sort(sorted.begin(), sorted.end());
-    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) return false;
-    if (cyc.size() < 3) {
-      if (cyc.size() == 2) return false;  // a facet collapsed onto an edge: glue by hull
-      cyc.clear();
-      continue;
-    }
-    for (std::size_t k = 0; k < cyc.size(); ++k) {
-      if (!directed.emplace(cyc[k], cyc[(k + 1) % cyc.size()]).second) return false;
-      used[cyc[k]] = 1;
+/// Halfedge connectivity of a soup: corner c is the edge from vertex[c] to the next
+/// corner's vertex; twin[c] the corner of the opposite edge.
+struct Connectivity {
+  std::vector<int> face, next, prev, twin;
+};
+
+/// Twins of every corner, or nothing when the soup is not a closed, oriented 2-manifold
+/// (an edge used twice in one direction or only once, a vertex with several fans).
+std::optional<Connectivity> connect(int num_points, const Soup& soup) {
+  const int nc = static_cast<int>(soup.vertex.size());
+  Connectivity k;
+  k.face.resize(nc);
+  k.next.resize(nc);
+  k.prev.resize(nc);
+  k.twin.assign(nc, -1);
+  for (int f = 0; f < soup.size(); ++f) {
+    const int b = soup.begin[f], e = soup.begin[f + 1];
+    for (int c = b; c < e; ++c) {
+      k.face[c] = f;
+      k.next[c] = c + 1 == e ? b : c + 1;
+      k.prev[c] = c == b ? e - 1 : c - 1;
     }
   }
-  for (const auto& [u, w] : directed)
-    if (!directed.count({w, u})) return false;
-  std::vector<Mesh::VertexHandle> handle(n);
-  Mesh m;
-  for (int v = 0; v < n; ++v)
-    if (used[v]) handle[v] = m.add_vertex(Point(points[v].x, points[v].y, points[v].z));
-  std::vector<Mesh::VertexHandle> fh;
-  std::vector<int> src;
-  for (int f = 0; f < nf; ++f) {
-    if (faces[f].empty()) continue;
-    fh.clear();
-    for (int v : faces[f]) fh.push_back(handle[v]);
-    if (!m.add_face(fh).is_valid()) return false;
-    src.push_back(f);
+  // Outgoing corners of each vertex (counting sort).
+  std::vector<int> out_begin(num_points + 1, 0), out(nc);
+  for (int c = 0; c < nc; ++c) ++out_begin[soup.vertex[c] + 1];
+  std::partial_sum(out_begin.begin(), out_begin.end(), out_begin.begin());
+  {
+    std::vector<int> fill(out_begin.begin(), out_begin.end() - 1);
+    for (int c = 0; c < nc; ++c) out[fill[soup.vertex[c]]++] = c;
   }
-  mesh = std::move(m);
-  if (source) *source = std::move(src);
+  auto target = [&](int c) { return soup.vertex[k.next[c]]; };
+  for (int v = 0; v < num_points; ++v) {
+    for (int i = out_begin[v]; i < out_begin[v + 1]; ++i) {
+      const int c = out[i], w = target(c);
+      for (int j = i + 1; j < out_begin[v + 1]; ++j)
+        if (target(out[j]) == w) return std::nullopt;  // v -> w twice
+      for (int j = out_begin[w]; j < out_begin[w + 1]; ++j)
+        if (target(out[j]) == v) k.twin[c] = out[j];
+      if (k.twin[c] < 0) return std::nullopt;  // v -> w has no opposite edge
+    }
+  }
+  // One fan per vertex: turning from an outgoing edge to the next reaches them all.
+  for (int v = 0; v < num_points; ++v) {
+    const int n = out_begin[v + 1] - out_begin[v];
+    if (n == 0) continue;
+    const int start = out[out_begin[v]];
+    int c = start, steps = 0;
+    do {
+      c = k.twin[k.prev[c]];
+      if (++steps > n) return std::nullopt;
+    } while (c != start);
+    if (steps != n) return std::nullopt;
+  }
+  return k;
+}
+
+/// A facet's plane and size in doubles.
+struct FacetGeometry {
+  V3<double> normal{0, 0, 0};  // unit (zero for a facet of zero area)
+  double offset = 0;           // <normal, x> = offset on the plane
+  double twice_area = 0;
+  double longest_edge = 0;
+};
+
+FacetGeometry geometry(const std::vector<V3<double>>& points, const Soup& soup, int f) {
+  FacetGeometry g;
+  const int b = soup.begin[f], d = soup.degree(f);
+  const V3<double>& origin = points[soup.vertex[b]];
+  V3<double> sum{0, 0, 0}, centroid{0, 0, 0};
+  for (int k = 0; k < d; ++k) {
+    const V3<double> p = points[soup.vertex[b + k]] - origin;
+    const V3<double> q = points[soup.vertex[b + (k + 1 == d ? 0 : k + 1)]] - origin;
+    sum = sum + cross(p, q);  // Newell's normal (twice the vector area)
+    const V3<double> e = q - p;
+    g.longest_edge = std::max(g.longest_edge, std::sqrt(dot(e, e)));
+    centroid = centroid + p;
+  }
+  centroid = {origin.x + centroid.x / d, origin.y + centroid.y / d, origin.z + centroid.z / d};
+  g.twice_area = std::sqrt(dot(sum, sum));
+  if (g.twice_area > 0) {
+    g.normal = {sum.x / g.twice_area, sum.y / g.twice_area, sum.z / g.twice_area};
+    g.offset = dot(g.normal, centroid);
+  }
+  return g;
+}
+
+bool is_thin(const FacetGeometry& g, double limit) { return g.twice_area <= 2 * limit * g.longest_edge; }
+
+struct Groups {
+  std::vector<int> of;  // group (its lowest facet index) of each facet
+  bool merged = false;
+};
+
+/// Groups facets that are coplanar to within `limit`: a facet joins a neighbour's group
+/// when all its vertices lie within `limit` of the plane of the group's largest facet,
+/// or the group joins it the other way round. Needles (facets thinner than `limit`) have
+/// no reliable plane of their own; they join a neighbour whose plane holds them.
+Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup, const Connectivity& k,
+                      const std::vector<FacetGeometry>& geo, double limit) {
+  const int nf = soup.size();
+  std::vector<int> parent(nf), reference(nf), next_member(nf, -1), last_member(nf);
+  std::iota(parent.begin(), parent.end(), 0);
+  std::iota(reference.begin(), reference.end(), 0);
+  std::iota(last_member.begin(), last_member.end(), 0);
+  auto find = [&](int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  // All vertices of group `g` within `limit` of the plane of facet `ref`.
+  auto holds = [&](int ref, int g) {
+    const FacetGeometry& p = geo[ref];
+    if (is_thin(p, limit)) return false;
+    for (int f = g; f >= 0; f = next_member[f])
+      for (int c = soup.begin[f]; c < soup.begin[f + 1]; ++c)
+        if (std::abs(dot(p.normal, points[soup.vertex[c]]) - p.offset) > limit) return false;
+    return true;
+  };
+  Groups out;
+  const int nc = static_cast<int>(soup.vertex.size());
+  for (int c = 0; c < nc; ++c) {
+    const int t = k.twin[c];
+    if (t < c) continue;
+    int a = find(k.face[c]), b = find(k.face[t]);
+    if (a == b) continue;
+    if (geo[reference[a]].twice_area < geo[reference[b]].twice_area) std::swap(a, b);
+    // a has the larger reference facet.
+    if (!holds(reference[a], b)) continue;
+    const int root = std::min(a, b), other = std::max(a, b);
+    parent[other] = root;
+    reference[root] = reference[a];
+    next_member[last_member[root]] = other;
+    last_member[root] = last_member[other];
+    out.merged = true;
+  }
+  out.of.resize(nf);
+  for (int f = 0; f < nf; ++f) out.of[f] = find(f);
+  return out;
+}
+
+/// Corner (interior angle) test of a polygon against its plane's normal: no corner is
+/// reflex by more than `limit`, and the polygon is not thinner than `limit`.
+bool convex_polygon(const std::vector<V3<double>>& points, const std::vector<int>& cycle, const V3<double>& normal,
+                    double limit) {
+  const int d = static_cast<int>(cycle.size());
+  for (int i = 0; i < d; ++i) {
+    const auto& a = points[cycle[i]];
+    const auto& b = points[cycle[(i + 1) % d]];
+    const auto& c = points[cycle[(i + 2) % d]];
+    const V3<double> ac = c - a;
+    const double base = std::sqrt(dot(ac, ac));
+    // Height of b over the chord a-c, positive when the corner at b is convex.
+    if (base > 0 && dot(cross(b - a, c - b), normal) / base < -limit) return false;
+  }
   return true;
 }
 
-/// The exact convex hull of the cluster points, its triangles grouped into the facets
-/// their corners came from.
-Mesh build_by_hull(const std::vector<V3<double>>& points, const std::vector<int>& face_begin,
-                   const std::vector<int>& corners, const std::vector<int>& rep, std::vector<int>* source) {
-  const int nf = static_cast<int>(face_begin.size()) - 1;
-  std::map<int, std::vector<int>> facets_of;  // cluster -> facets that had a corner in it
+/// Passes 2 and 3 on a closed manifold soup: the polygons of its coplanar groups go to
+/// `out` (`changed` tells whether any merged; `out` is untouched if not). False when a
+/// group is not one disc or its polygon is not convex; `strict`: also when a needle finds
+/// no group.
+bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, const Connectivity& k, double limit,
+                    bool strict, Soup& merged, bool& changed) {
+  const int nf = soup.size();
+  std::vector<FacetGeometry> geo(nf);
+  for (int f = 0; f < nf; ++f) geo[f] = geometry(points, soup, f);
+  const Groups groups = group_coplanar(points, soup, k, geo, limit);
+  if (strict)
+    for (int f = 0; f < nf; ++f)
+      if (is_thin(geo[f], limit) && groups.of[f] == f) {
+        bool alone = true;
+        for (int c = soup.begin[f]; c < soup.begin[f + 1] && alone; ++c) alone = groups.of[k.face[k.twin[c]]] != f;
+        if (alone) return false;
+      }
+  changed = groups.merged;
+  if (!groups.merged) return true;
+  const auto group = [&](int c) { return groups.of[k.face[c]]; };
+  // Vertices keep their place when at least three groups meet there.
+  const int nc = static_cast<int>(soup.vertex.size());
+  std::vector<char> keep(points.size(), 0), seen(points.size(), 0);
+  for (int c = 0; c < nc; ++c) {
+    const int v = soup.vertex[c];
+    if (seen[v]) continue;
+    seen[v] = 1;
+    int g1 = -1, g2 = -1, distinct = 0, e = c;
+    do {
+      const int g = group(e);
+      if (g != g1 && g != g2) {
+        if (g1 < 0) g1 = g;
+        else if (g2 < 0) g2 = g;
+        ++distinct;
+      }
+      e = k.twin[k.prev[e]];
+    } while (e != c && distinct < 3);
+    keep[v] = distinct >= 3;
+  }
+  // The boundary of each group, walked from its first boundary corner.
+  std::vector<char> walked(nc, 0);
+  std::vector<int> cycles(nf, 0);
+  Soup out;
+  std::vector<int> cycle;
+  std::vector<int> largest(nf, -1);  // the group's largest facet gives its source
+  for (int f = 0; f < nf; ++f) {
+    int& l = largest[groups.of[f]];
+    if (l < 0 || geo[f].twice_area > geo[l].twice_area) l = f;
+  }
+  std::vector<int> first_boundary(nf, -1);
+  for (int c = 0; c < nc; ++c)
+    if (group(c) != group(k.twin[c]) && first_boundary[group(c)] < 0) first_boundary[group(c)] = c;
+  for (int g = 0; g < nf; ++g) {
+    if (groups.of[g] != g) continue;
+    const int start = first_boundary[g];
+    if (start < 0) return false;  // a group without boundary: everything is flat
+    cycle.clear();
+    int c = start, steps = 0;
+    do {
+      walked[c] = 1;
+      if (keep[soup.vertex[c]]) cycle.push_back(soup.vertex[c]);
+      // The next boundary corner: turn around the edge's end inside the group.
+      int n = k.next[c];
+      while (group(k.twin[n]) == g) {
+        n = k.next[k.twin[n]];
+        if (++steps > nc) return false;
+      }
+      c = n;
+      if (++steps > nc) return false;
+    } while (c != start);
+    if (cycle.size() < 3 || !convex_polygon(points, cycle, geo[largest[g]].normal, limit)) return false;
+    out.add(cycle, soup.source[largest[g]]);
+  }
+  // A group with a second boundary cycle is not a disc.
+  for (int c = 0; c < nc; ++c)
+    if (group(c) != group(k.twin[c]) && !walked[c]) return false;
+  merged = std::move(out);
+  return true;
+}
+
+/// Passes 2 and 3, then connectivity of the result. Strict: nothing when the soup is not
+/// a closed manifold or merging fails; else (hull triangles) an unmerged soup is kept.
+std::optional<std::pair<Soup, Connectivity>> simplify(const std::vector<V3<double>>& points, Soup soup,
+                                                      double limit, bool strict) {
+  std::optional<Connectivity> k = connect(static_cast<int>(points.size()), soup);
+  if (!k) return std::nullopt;
+  Soup merged;
+  bool changed = false;
+  if (!merge_coplanar(points, soup, *k, limit, strict, merged, changed)) {
+    if (strict) return std::nullopt;
+    return std::make_pair(std::move(soup), std::move(*k));
+  }
+  if (!changed) return std::make_pair(std::move(soup), std::move(*k));
+  std::optional<Connectivity> km = connect(static_cast<int>(points.size()), merged);
+  if (km) return std::make_pair(std::move(merged), std::move(*km));
+  if (strict) return std::nullopt;
+  return std::make_pair(std::move(soup), std::move(*k));
+}
+
+/// The OpenMesh mesh of a closed manifold soup, built straight from its connectivity
+/// (no per-face searches). Vertices in index order, faces in soup order, each face's
+/// vertex cycle starting where the soup's does.
+Mesh build(const std::vector<V3<double>>& points, const Soup& soup, const Connectivity& k) {
+  Mesh mesh;
+  const int nc = static_cast<int>(soup.vertex.size());
+  std::vector<Mesh::VertexHandle> handle(points.size());
+  std::vector<char> used(points.size(), 0);
+  for (int v : soup.vertex) used[v] = 1;
+  int num_used = 0;
+  for (char u : used) num_used += u;
+  mesh.reserve(num_used, nc / 2, soup.size());
+  for (std::size_t v = 0; v < points.size(); ++v)
+    if (used[v]) handle[v] = mesh.add_vertex(Point(points[v].x, points[v].y, points[v].z));
+  std::vector<Mesh::HalfedgeHandle> he(nc);
+  for (int c = 0; c < nc; ++c) {
+    const int t = k.twin[c];
+    if (t < c) {
+      he[c] = mesh.opposite_halfedge_handle(he[t]);
+    } else {
+      he[c] = mesh.new_edge(handle[soup.vertex[c]], handle[soup.vertex[k.next[c]]]);
+    }
+  }
+  for (int f = 0; f < soup.size(); ++f) {
+    const auto fh = mesh.new_face();
+    const int b = soup.begin[f], e = soup.begin[f + 1];
+    for (int c = b; c < e; ++c) {
+      mesh.set_face_handle(he[c], fh);
+      mesh.set_next_halfedge_handle(he[c], he[k.next[c]]);
+      mesh.set_halfedge_handle(handle[soup.vertex[c]], he[c]);
+    }
+    mesh.set_halfedge_handle(fh, he[e - 1]);  // as add_face: the cycle starts at vertex b
+  }
+  return mesh;
+}
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using HullMesh = CGAL::Surface_mesh<Kernel::Point_3>;
+
+/// The triangles of the convex hull of the cluster points (exact predicates on the
+/// doubles), each with the result facet it belongs to: among the facets its corners came
+/// from (those shared by all three when there are any), the one whose normal is closest.
+Soup hull_triangles(const std::vector<V3<double>>& points, const Soup& facets) {
+  const int nf = facets.size();
+  std::map<int, std::vector<int>> facets_of;  // point -> facets that have it as a corner
   for (int f = 0; f < nf; ++f)
-    for (int c = face_begin[f]; c < face_begin[f + 1]; ++c) facets_of[rep[corners[c]]].push_back(f);
+    for (int c = facets.begin[f]; c < facets.begin[f + 1]; ++c) facets_of[facets.vertex[c]].push_back(f);
   std::vector<Kernel::Point_3> pts;
-  std::map<Kernel::Point_3, int> cluster_of;
-  for (auto& [cl, fs] : facets_of) {
+  std::map<Kernel::Point_3, int> point_of;
+  for (auto& [v, fs] : facets_of) {
     std::sort(fs.begin(), fs.end());
     fs.erase(std::unique(fs.begin(), fs.end()), fs.end());
-    const auto& p = points[cl];
-    pts.emplace_back(p.x, p.y, p.z);
-    cluster_of.emplace(pts.back(), cl);
+    pts.emplace_back(points[v].x, points[v].y, points[v].z);
+    point_of.emplace(pts.back(), v);
   }
   HullMesh hull;
   CGAL::convex_hull_3(pts.begin(), pts.end(), hull);
-  // Unit normals of the result's facets (from their rounded corners).
+  if (hull.number_of_faces() == 0) throw error("internal error: a result is flat");
   std::vector<V3<double>> facet_normal(nf);
   for (int f = 0; f < nf; ++f) {
     V3<double> sum{0, 0, 0};
-    for (int c = face_begin[f]; c < face_begin[f + 1]; ++c) {
-      const auto& p = points[corners[c]];
-      const auto& q = points[corners[c + 1 == face_begin[f + 1] ? face_begin[f] : c + 1]];
-      sum = sum + cross(p, q);
-    }
+    for (int c = facets.begin[f]; c < facets.begin[f + 1]; ++c)
+      sum = sum + cross(points[facets.vertex[c]], points[facets.vertex[c + 1 == facets.begin[f + 1] ? facets.begin[f] : c + 1]]);
     const double len = std::sqrt(dot(sum, sum));
     facet_normal[f] = len > 0 ? V3<double>{sum.x / len, sum.y / len, sum.z / len} : sum;
   }
-  // Facet of each hull triangle: among the facets its corners came from (those shared by
-  // all three when there are any), the one whose normal is closest to the triangle's.
-  std::map<HullMesh::Face_index, int> facet;
-  int next_own = nf;
+  // CGAL's hull keys internal maps by pointer, so its face order is not reproducible:
+  // triangles are ordered by their point indices, each starting at its lowest.
+  std::vector<std::array<int, 4>> tris;  // three points, source
   for (auto t : hull.faces()) {
-    std::vector<int> cl;
-    for (auto v : CGAL::vertices_around_face(hull.halfedge(t), hull)) cl.push_back(cluster_of.at(hull.point(v)));
-    std::vector<int> common = facets_of.at(cl[0]), all = common;
-    for (std::size_t k = 1; k < cl.size(); ++k) {
-      const auto& fs = facets_of.at(cl[k]);
-      std::vector<int> keep;
-      std::set_intersection(common.begin(), common.end(), fs.begin(), fs.end(), std::back_inserter(keep));
-      common = std::move(keep);
+    std::vector<int> tri;
+    for (auto v : CGAL::vertices_around_face(hull.halfedge(t), hull)) tri.push_back(point_of.at(hull.point(v)));
+    std::rotate(tri.begin(), std::min_element(tri.begin(), tri.end()), tri.end());
+    std::vector<int> common = facets_of.at(tri[0]), all = common;
+    for (int k = 1; k < 3; ++k) {
+      const auto& fs = facets_of.at(tri[k]);
+      std::vector<int> both;
+      std::set_intersection(common.begin(), common.end(), fs.begin(), fs.end(), std::back_inserter(both));
+      common = std::move(both);
       all.insert(all.end(), fs.begin(), fs.end());
     }
     const std::vector<int>& candidates = common.empty() ? all : common;
-    const V3<double> tn = cross(points[cl[1]] - points[cl[0]], points[cl[2]] - points[cl[0]]);
+    const V3<double> tn = cross(points[tri[1]] - points[tri[0]], points[tri[2]] - points[tri[0]]);
     int best = -1;
     double best_dot = -2;
     for (int f : candidates) {
@@ -129,71 +392,12 @@ Mesh build_by_hull(const std::vector<V3<double>>& points, const std::vector<int>
         best = f;
       }
     }
-    facet[t] = best >= 0 ? best : next_own++;
+    tris.push_back({tri[0], tri[1], tri[2], best >= 0 ? facets.source[best] : -1});
   }
-  // Boundary cycle of each group; a group that is not one disc keeps its triangles.
-  std::map<int, std::vector<HullMesh::Face_index>> groups;
-  for (auto t : hull.faces()) groups[facet[t]].push_back(t);
-  // CGAL's hull keys internal maps by pointer, so its order is not reproducible: everything
-  // below is ordered by cluster index instead (vertices, cycle starts, loose triangles).
-  Mesh mesh;
-  std::map<int, Mesh::VertexHandle> handle;
-  auto vertex = [&](HullMesh::Vertex_index v) { return handle.at(cluster_of.at(hull.point(v))); };
-  auto cluster = [&](HullMesh::Vertex_index v) { return cluster_of.at(hull.point(v)); };
-  std::vector<std::pair<std::vector<HullMesh::Vertex_index>, int>> out_faces;
-  for (auto& [g, tris] : groups) {
-    std::map<HullMesh::Vertex_index, HullMesh::Vertex_index> next;
-    bool disc = true;
-    for (auto t : tris)
-      for (auto h : CGAL::halfedges_around_face(hull.halfedge(t), hull))
-        if (facet[hull.face(hull.opposite(h))] != g)
-          disc = disc && next.emplace(hull.source(h), hull.target(h)).second;
-    std::vector<HullMesh::Vertex_index> cyc;
-    if (disc && !next.empty()) {
-      auto start = next.begin()->first;
-      for (const auto& [v, w] : next)
-        if (cluster(v) < cluster(start)) start = v;
-      auto v = start;
-      do {
-        cyc.push_back(v);
-        v = next.at(v);
-      } while (v != start && cyc.size() <= next.size());
-      disc = cyc.size() == next.size();
-    }
-    const int src = g < nf ? g : -1;
-    if (disc) {
-      out_faces.emplace_back(std::move(cyc), src);
-    } else {
-      std::vector<std::vector<HullMesh::Vertex_index>> loose;
-      for (auto t : tris) {
-        std::vector<HullMesh::Vertex_index> tri;
-        for (auto v : CGAL::vertices_around_face(hull.halfedge(t), hull)) tri.push_back(v);
-        std::rotate(tri.begin(), std::min_element(tri.begin(), tri.end(), [&](auto a, auto b) {
-                      return cluster(a) < cluster(b);
-                    }), tri.end());
-        loose.push_back(std::move(tri));
-      }
-      std::sort(loose.begin(), loose.end(), [&](const auto& a, const auto& b) {
-        return std::make_tuple(cluster(a[0]), cluster(a[1]), cluster(a[2])) <
-               std::make_tuple(cluster(b[0]), cluster(b[1]), cluster(b[2]));
-      });
-      for (auto& tri : loose) out_faces.emplace_back(std::move(tri), src);
-    }
-  }
-  for (const auto& f : out_faces)
-    for (auto v : f.first) handle[cluster(v)];
-  for (auto& [cl, h] : handle) h = mesh.add_vertex(Point(points[cl].x, points[cl].y, points[cl].z));
-  std::vector<int> src;
-  std::vector<Mesh::VertexHandle> fh;
-  for (auto& [cyc, s] : out_faces) {
-    fh.clear();
-    for (auto v : cyc) fh.push_back(vertex(v));
-    if (!mesh.add_face(fh).is_valid())
-      throw error("internal error: the hull of a result could not be joined into a mesh");
-    src.push_back(s);
-  }
-  if (source) *source = std::move(src);
-  return mesh;
+  std::sort(tris.begin(), tris.end());
+  Soup out;
+  for (const auto& t : tris) out.add({t[0], t[1], t[2]}, t[3]);
+  return out;
 }
 
 }  // namespace
@@ -211,21 +415,18 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
   }
   const V3<double> span = hi - lo;
   const double limit = kFeatureTolerance * std::sqrt(dot(span, span));
+  // Pass 1: clusters of close corners, each represented by its lowest vertex.
   std::vector<int> rep(n);
   std::iota(rep.begin(), rep.end(), 0);
   auto find = [&](int x) {
     while (rep[x] != x) x = rep[x] = rep[rep[x]];
     return x;
   };
-  bool merged = false;
   auto merge_if_close = [&](int u, int w) {
     const V3<double> d = points[u] - points[w];
     if (std::sqrt(dot(d, d)) <= limit) {
       const int a = find(u), b = find(w);
-      if (a != b) {
-        rep[std::max(a, b)] = std::min(a, b);
-        merged = true;
-      }
+      if (a != b) rep[std::max(a, b)] = std::min(a, b);
     }
   };
   for (int f = 0; f < nf; ++f) {
@@ -237,29 +438,29 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
       for (int c = b; c < e; ++c) merge_if_close(corners[c], corners[c + 1 == e ? b : c + 1]);
     }
   }
-  for (int v = 0; v < n; ++v) rep[v] = find(v);
-  Mesh mesh;
-  if (build_direct(points, face_begin, corners, rep, mesh, source)) {
-    if (!merged) return mesh;
-    // Merged: check that every facet still turns convexly; else rebuild by hull.
-    bool convex = true;
-    for (auto f : mesh.faces()) {
-      const auto nrm = mesh.calc_face_normal(f);
-      double longest = 0;
-      for (auto h : mesh.fh_range(f)) longest = std::max(longest, mesh.calc_edge_length(h));
-      OpenMesh::Vec3d twice_area(0, 0, 0);
-      for (auto h : mesh.fh_range(f))
-        twice_area += OpenMesh::cross(mesh.point(mesh.from_vertex_handle(h)), mesh.point(mesh.to_vertex_handle(h)));
-      if (twice_area.norm() <= 2 * limit * longest) convex = false;  // thinner than the feature size
-      for (auto h : mesh.fh_range(f)) {
-        const auto a = mesh.point(mesh.from_vertex_handle(h)), b = mesh.point(mesh.to_vertex_handle(h)),
-                   c = mesh.point(mesh.to_vertex_handle(mesh.next_halfedge_handle(h)));
-        if (OpenMesh::dot(OpenMesh::cross(b - a, c - b), nrm) <= 0) convex = false;
-      }
+  Soup soup;
+  soup.vertex.reserve(corners.size());
+  soup.source.reserve(nf);
+  bool repeated = false;
+  std::vector<int> cycle;
+  for (int f = 0; f < nf; ++f) {
+    cycle.clear();
+    for (int c = face_begin[f]; c < face_begin[f + 1]; ++c) {
+      const int v = find(corners[c]);
+      if (cycle.empty() || cycle.back() != v) cycle.push_back(v);
     }
-    if (convex) return mesh;
+    while (cycle.size() > 1 && cycle.front() == cycle.back()) cycle.pop_back();
+    if (cycle.size() < 3) continue;  // collapsed onto an edge or a point: its neighbours meet
+    for (std::size_t i = 0; i < cycle.size() && !repeated; ++i)
+      for (std::size_t j = i + 1; j < cycle.size() && !repeated; ++j) repeated = cycle[i] == cycle[j];
+    soup.add(cycle, f);
   }
-  return build_by_hull(points, face_begin, corners, rep, source);
+  std::optional<std::pair<Soup, Connectivity>> result;
+  if (!repeated) result = simplify(points, soup, limit, true);
+  if (!result) result = simplify(points, hull_triangles(points, soup), limit, false);
+  if (!result) throw error("internal error: the hull of a result could not be joined into a mesh");
+  if (source) *source = result->first.source;
+  return build(points, result->first, result->second);
 }
 
 }  // namespace morph::detail

@@ -589,6 +589,62 @@ std::string compare_close(const Description& got, const Description& want, doubl
   return s.str();
 }
 
+std::string subresolution_feature(const Description& d, double tol) {
+  auto sub = [](const Position& a, const Position& b) { return Position{a[0] - b[0], a[1] - b[1], a[2] - b[2]}; };
+  auto dot3 = [](const Position& a, const Position& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
+  auto length = [&](const Position& a) { return std::sqrt(dot3(a, a)); };
+  std::map<Position, std::vector<std::size_t>> facets_at;
+  for (std::size_t f = 0; f < d.facets.size(); ++f)
+    for (const Position& p : d.facets[f]) facets_at[p].push_back(f);
+  // Close vertices are found through a grid of cells of size tol.
+  std::map<std::array<long long, 3>, std::vector<Position>> grid;
+  for (const Position& p : d.vertices) {
+    const std::array<long long, 3> cell{static_cast<long long>(std::floor(p[0] / tol)),
+                                        static_cast<long long>(std::floor(p[1] / tol)),
+                                        static_cast<long long>(std::floor(p[2] / tol))};
+    for (long long dx = -1; dx <= 1; ++dx)
+      for (long long dy = -1; dy <= 1; ++dy)
+        for (long long dz = -1; dz <= 1; ++dz) {
+          auto it = grid.find({cell[0] + dx, cell[1] + dy, cell[2] + dz});
+          if (it == grid.end()) continue;
+          for (const Position& q : it->second)
+            if (length(sub(p, q)) < tol) return "two vertices closer than the feature size";
+        }
+    grid[cell].push_back(p);
+  }
+  for (std::size_t f = 0; f < d.facets.size(); ++f) {
+    const auto& fp = d.facets[f];
+    std::size_t a = 0, b = 1;
+    double far = -1;
+    for (std::size_t i = 0; i < fp.size(); ++i)
+      for (std::size_t j = i + 1; j < fp.size(); ++j)
+        if (length(sub(fp[i], fp[j])) > far) far = length(sub(fp[i], fp[j])), a = i, b = j;
+    const Position axis = sub(fp[b], fp[a]);
+    double width = 0;
+    for (const Position& p : fp) {
+      const Position r = sub(p, fp[a]);
+      const double along = dot3(r, axis) / dot3(axis, axis);
+      width = std::max(width, length(sub(r, Position{along * axis[0], along * axis[1], along * axis[2]})));
+    }
+    if (width < tol) return "a facet thinner than the feature size";
+  }
+  for (std::size_t f = 0; f < d.facets.size(); ++f) {
+    std::map<std::size_t, int> shared;
+    for (const Position& p : d.facets[f])
+      for (std::size_t g : facets_at[p])
+        if (g != f) ++shared[g];
+    for (const auto& [g, count] : shared) {
+      if (count < 2 || !d.planes[f].reliable) continue;
+      const Plane& h = d.planes[f];
+      const bool flat = std::all_of(d.facets[g].begin(), d.facets[g].end(), [&](const Position& p) {
+        return std::abs(dot3(h.normal, p) - h.offset) <= tol;
+      });
+      if (flat) return "two neighbouring facets coplanar to within the feature size";
+    }
+  }
+  return {};
+}
+
 bool exactly_planar(const Mesh& mesh) {
   for (auto f : mesh.faces()) {
     std::vector<IPoint> p;

@@ -81,6 +81,14 @@ std::string compare_close(const Description& got, const Description& want, doubl
 /// (<= 0 when inner's vertices are all inside outer).
 double max_excess(const Description& inner, const Description& outer);
 
+/// The first feature of an exact description smaller than `tol` (absolute), or empty: two
+/// vertices closer than `tol`, a facet thinner than `tol` (its vertices within `tol` of
+/// the line through its two farthest ones), or two facets sharing an edge whose vertices
+/// all lie within `tol` of the other's plane. The library merges such features
+/// (kFeatureTolerance, docs/algorithm.md), so a result is compared with a description that
+/// has any only to within the feature size.
+std::string subresolution_feature(const Description& d, double tol);
+
 /// True when every face of the mesh is exactly planar (exact orientation tests).
 bool exactly_planar(const Mesh& mesh);
 
