@@ -218,12 +218,11 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
         for (int c = soup.begin[f]; c < soup.begin[f + 1] && alone; ++c) alone = groups.of[k.face[k.twin[c]]] != f;
         if (alone) return false;
       }
-  changed = groups.merged;
-  if (!groups.merged) return true;
   const auto group = [&](int c) { return groups.of[k.face[c]]; };
   // Vertices keep their place when at least three groups meet there.
   const int nc = static_cast<int>(soup.vertex.size());
   std::vector<char> keep(points.size(), 0), seen(points.size(), 0);
+  bool dropped = false;
   for (int c = 0; c < nc; ++c) {
     const int v = soup.vertex[c];
     if (seen[v]) continue;
@@ -239,7 +238,10 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
       e = k.twin[k.prev[e]];
     } while (e != c && distinct < 3);
     keep[v] = distinct >= 3;
+    dropped = dropped || !keep[v];
   }
+  changed = groups.merged || dropped;
+  if (!changed) return true;
   // The boundary of each group, walked from its first boundary corner.
   std::vector<char> walked(nc, 0);
   std::vector<int> cycles(nf, 0);
