@@ -396,6 +396,27 @@ TEST_CASE("fims: A plus A is 2A with the facet degrees of A") {
   }
 }
 
+// A scaled copy of A has facets and edges parallel to A's only up to rounding: the exact
+// sum of the doubles is 1.1 A plus facets and needles of width ~1e-17, which must all merge.
+TEST_CASE("fims: A plus a scaled copy of A is the scaled A, and the result chains") {
+  for (int level : {1, 2, 3}) {
+    INFO("icosphere level ", level);
+    const Mesh A = make_icosphere(1.0, level);
+    const Mesh B = make_icosphere(0.1, level);
+    const LabelledMesh S = minkowski_sum(A, B);
+    CHECK(S.mesh.n_vertices() == A.n_vertices());
+    CHECK(S.mesh.n_faces() == A.n_faces());
+    const std::string close = compare_close(describe(S.mesh), describe(scaled(A, 1.1)), 1e-12 * 2.2, 1e-12);
+    CHECK_MESSAGE(close.empty(), close);
+    CHECK_MESSAGE(clean_mesh_problem(S.mesh, kRoundedClean).empty(), clean_mesh_problem(S.mesh, kRoundedClean));
+    CHECK(subresolution_feature(describe(S.mesh), 0.5e-11 * bbox_diagonal(S.mesh)).empty());
+    // The result is a valid operand again (it used to keep zero-area needles).
+    CHECK(check_convex_polyhedron(S.mesh).ok());
+    const LabelledMesh S2 = minkowski_sum(S.mesh, B);
+    CHECK(S2.mesh.n_faces() == A.n_faces());
+  }
+}
+
 TEST_CASE("fims: an element away from the origin translates the sum") {
   // Grid coordinates: every sum and translation here is exact, so equality is exact.
   const Mesh A = random_grid_polytope(30, 21);

@@ -114,18 +114,6 @@ MorphResult run_close(const Mesh& A, const Mesh& B) {
 // The feature size below which the library merges corners (morphology.h), with margin.
 constexpr double kLibraryFeatureTolerance = 2e-11;
 
-// Smallest distance between two vertices of a description (features of the exact set).
-double min_vertex_distance(const Description& d) {
-  double best = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < d.vertices.size(); ++i)
-    for (std::size_t j = i + 1; j < d.vertices.size(); ++j) {
-      const auto& p = d.vertices[i];
-      const auto& q = d.vertices[j];
-      best = std::min(best, std::hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]));
-    }
-  return best;
-}
-
 // The result must be the exact set: the same body to rounding, and, when `exact` (the
 // operands' facets whose planes matter are exactly planar), the same description exactly:
 // vertex positions rounded to nearest, facets as position sets, counts. Or the right kind
@@ -146,12 +134,16 @@ void check_against(const MorphResult& r, const ExactSet& want, const Mesh& A, bo
   const double tol = exact ? kRoundedTol : kPlanarityTolerance;
   const std::string body = compare_close(got, want.description, tol * bbox_diagonal(A), 1e-9);
   CHECK_MESSAGE(body.empty(), body);
-  // The library merges features of the exact set below 1e-11 of the diagonal (morphology.h):
-  // the exact description must match only when the exact set has none.
-  if (exact && min_vertex_distance(want.description) > kLibraryFeatureTolerance * bbox_diagonal(r.mesh)) {
+  // The library merges features of the exact set below 1e-11 of the diagonal (fims.h,
+  // docs/algorithm.md): the exact description must match only when the exact set has none,
+  // and the result must keep none.
+  const double diag = bbox_diagonal(r.mesh);
+  if (exact && subresolution_feature(want.description, kLibraryFeatureTolerance * diag).empty()) {
     const std::string diff = compare_exact(got, want.description);
     CHECK_MESSAGE(diff.empty(), "not the exact set rounded once: ", diff);
   }
+  const std::string left = subresolution_feature(got, 0.5e-11 * diag);
+  CHECK_MESSAGE(left.empty(), "the result has ", left);
 }
 
 void check_erosion(const Mesh& A, const Mesh& B, const std::string& name) {
@@ -218,21 +210,13 @@ TEST_CASE("morph: oracle self-check on exact erosion and opening") {
 // ---------------------------------------------------------------------------------------
 // Against the exact references
 
-// KNOWN DEFECT (open, see the notes on the morphology issue): these cases feed results with
-// sub-resolution features (slivers) back into an erosion; the output can then differ from
-// run to run and from the reference. Marked may_fail: they run and print every failure.
-TEST_CASE("morph: erosion equals the exact half-space intersection" * doctest::may_fail()) {
+TEST_CASE("morph: erosion equals the exact half-space intersection") {
   for (const Named& a : operands()) {
     for (const Named& b : elements(0.15, 7)) check_erosion(a.mesh, b.mesh, a.name + " by " + b.name);
   }
 }
 
-// KNOWN DEFECT (open, see the notes on the morphology issue): where the exact result has
-// features below double precision (icosphere samples eroded by icospheres of the same
-// construction; erosions of rounded dilations), the merged output can still contain a
-// sliver, a reflex corner of rounding size or a degree-2 vertex. The test runs and prints
-// every failure, but is marked may_fail until clean_mesh removes slivers topologically.
-TEST_CASE("morph: erosion and opening of the samples equal the exact references" * doctest::may_fail()) {
+TEST_CASE("morph: erosion and opening of the samples equal the exact references") {
   const std::vector<Named> all = samples();
   REQUIRE_MESSAGE(all.size() >= 3, "expected at least 3 small convex samples/*.off in ", MORPH_SAMPLES_DIR);
   for (const Named& a : all) {
@@ -244,10 +228,7 @@ TEST_CASE("morph: erosion and opening of the samples equal the exact references"
   }
 }
 
-// KNOWN DEFECT (open, see the notes on the morphology issue): these cases feed results with
-// sub-resolution features (slivers) back into an erosion; the output can then differ from
-// run to run and from the reference. Marked may_fail: they run and print every failure.
-TEST_CASE("morph: opening equals the exact hull of the exact erosion plus B" * doctest::may_fail()) {
+TEST_CASE("morph: opening equals the exact hull of the exact erosion plus B") {
   for (const Named& a : operands()) {
     for (const Named& b : elements(0.2, 9)) check_opening(a.mesh, b.mesh, a.name + " by " + b.name);
   }
@@ -286,12 +267,7 @@ TEST_CASE("morph: closing a convex polytope gives it back") {
   }
 }
 
-// KNOWN DEFECT (open, see the notes on the morphology issue): where the exact result has
-// features below double precision (icosphere samples eroded by icospheres of the same
-// construction; erosions of rounded dilations), the merged output can still contain a
-// sliver, a reflex corner of rounding size or a degree-2 vertex. The test runs and prints
-// every failure, but is marked may_fail until clean_mesh removes slivers topologically.
-TEST_CASE("morph: eroding a dilation gives A back" * doctest::may_fail()) {
+TEST_CASE("morph: eroding a dilation gives A back") {
   // Integer A and dyadic B: the dilation is exact in doubles, so the equality is exact.
   for (std::uint64_t s = 1; s <= 4; ++s) {
     const Mesh A = random_integer_polytope(15, 70 + s, 3);
@@ -319,10 +295,7 @@ TEST_CASE("morph: eroding a dilation gives A back" * doctest::may_fail()) {
   }
 }
 
-// KNOWN DEFECT (open, see the notes on the morphology issue): these cases feed results with
-// sub-resolution features (slivers) back into an erosion; the output can then differ from
-// run to run and from the reference. Marked may_fail: they run and print every failure.
-TEST_CASE("morph: opening is inside A and idempotent; dilating an erosion stays inside A" * doctest::may_fail()) {
+TEST_CASE("morph: opening is inside A and idempotent; dilating an erosion stays inside A") {
   for (const Named& a : operands()) {
     const Description outer = describe(a.mesh);
     const double diag = bbox_diagonal(a.mesh);

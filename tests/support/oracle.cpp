@@ -134,13 +134,16 @@ int affine_dimension(const std::vector<P>& pts) {
 }
 
 Plane approximate_plane(const EK::Plane_3& plane, const EPoint& on) {
+  // Epeck's to_double is the centre of a lazy interval, which can be wide after a long
+  // construction: round the exact values instead.
   const auto v = plane.orthogonal_vector();
-  double n[3] = {CGAL::to_double(v.x()), CGAL::to_double(v.y()), CGAL::to_double(v.z())};
+  double n[3] = {CGAL::to_double(CGAL::exact(v.x())), CGAL::to_double(CGAL::exact(v.y())),
+                 CGAL::to_double(CGAL::exact(v.z()))};
   const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
   Plane out;
   for (int k = 0; k < 3; ++k) out.normal[k] = n[k] / len;
-  out.offset = out.normal[0] * CGAL::to_double(on.x()) + out.normal[1] * CGAL::to_double(on.y()) +
-               out.normal[2] * CGAL::to_double(on.z());
+  out.offset = out.normal[0] * CGAL::to_double(CGAL::exact(on.x())) +
+               out.normal[1] * CGAL::to_double(CGAL::exact(on.y())) + out.normal[2] * CGAL::to_double(CGAL::exact(on.z()));
   return out;
 }
 
