@@ -28,8 +28,6 @@ using namespace morph::test;
 // agree to far below any visible feature, yet far above double rounding.
 constexpr double kApproxDistance = 1e-9;  // relative to the sum's bounding-box diagonal
 constexpr double kApproxVolume = 1e-9;    // relative volume difference
-// The feature size below which the library merges (kFeatureTolerance = 1e-11), with margin.
-constexpr double kLibraryFeatureTolerance = 2e-11;
 
 std::vector<int> element_vertices(const Mesh& m, const Element& e) {
   std::vector<int> out;
@@ -167,7 +165,7 @@ void check_sum(const Mesh& A, const Mesh& B, const std::string& name) {
     CHECK(got.facet_count <= want.facet_count);
   }
   // Nothing below the feature size is left (half of it: a margin for the rounding).
-  const std::string left = subresolution_feature(got, 0.5e-11 * bbox_diagonal(S.mesh));
+  const std::string left = subresolution_feature(got, kResultFeatureTolerance * bbox_diagonal(S.mesh));
   CHECK_MESSAGE(left.empty(), "the result has ", left);
   const std::string clean =
       clean_mesh_problem(S.mesh, planar_operands && feature.empty() ? clean_options_for(want) : kRoundedClean);
@@ -409,7 +407,7 @@ TEST_CASE("fims: A plus a scaled copy of A is the scaled A, and the result chain
     const std::string close = compare_close(describe(S.mesh), describe(scaled(A, 1.1)), 1e-12 * 2.2, 1e-12);
     CHECK_MESSAGE(close.empty(), close);
     CHECK_MESSAGE(clean_mesh_problem(S.mesh, kRoundedClean).empty(), clean_mesh_problem(S.mesh, kRoundedClean));
-    CHECK(subresolution_feature(describe(S.mesh), 0.5e-11 * bbox_diagonal(S.mesh)).empty());
+    CHECK(subresolution_feature(describe(S.mesh), kResultFeatureTolerance * bbox_diagonal(S.mesh)).empty());
     // The result is a valid operand again (it used to keep zero-area needles).
     CHECK(check_convex_polyhedron(S.mesh).ok());
     const LabelledMesh S2 = minkowski_sum(S.mesh, B);

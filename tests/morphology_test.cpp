@@ -111,8 +111,6 @@ MorphResult run_close(const Mesh& A, const Mesh& B) {
   return run([](const Mesh& a, const Mesh& b, const MorphologyOptions& o) { return morph::close(a, b, o); }, A, B);
 }
 
-// The feature size below which the library merges corners (morphology.h), with margin.
-constexpr double kLibraryFeatureTolerance = 2e-11;
 
 // The result must be the exact set: the same body to rounding, and, when `exact` (the
 // operands' facets whose planes matter are exactly planar), the same description exactly:
@@ -142,7 +140,7 @@ void check_against(const MorphResult& r, const ExactSet& want, const Mesh& A, bo
     const std::string diff = compare_exact(got, want.description);
     CHECK_MESSAGE(diff.empty(), "not the exact set rounded once: ", diff);
   }
-  const std::string left = subresolution_feature(got, 0.5e-11 * diag);
+  const std::string left = subresolution_feature(got, kResultFeatureTolerance * diag);
   CHECK_MESSAGE(left.empty(), "the result has ", left);
 }
 

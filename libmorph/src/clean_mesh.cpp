@@ -18,11 +18,11 @@
 #include <CGAL/convex_hull_3.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <numeric>
 #include <optional>
-#include <set>
 
 #include "fims.h"
 
@@ -185,7 +185,7 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup, c
 }
 
 /// Corner (interior angle) test of a polygon against its plane's normal: no corner is
-/// reflex by more than `limit`, and the polygon is not thinner than `limit`.
+/// reflex by more than `limit`.
 bool convex_polygon(const std::vector<V3<double>>& points, const std::vector<int>& cycle, const V3<double>& normal,
                     double limit) {
   const int d = static_cast<int>(cycle.size());
@@ -244,7 +244,6 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
   if (!changed) return true;
   // The boundary of each group, walked from its first boundary corner.
   std::vector<char> walked(nc, 0);
-  std::vector<int> cycles(nf, 0);
   Soup out;
   std::vector<int> cycle;
   std::vector<int> largest(nf, -1);  // the group's largest facet gives its source

@@ -45,13 +45,15 @@ Polytope sum_polytope(const Polytope& A, const Polytope& B, const SumFacets& fac
 /// noise of floating-point input (about 1e-15 relative).
 inline constexpr double kFeatureTolerance = 1e-11;
 
-/// Builds the output mesh from rounded points and facet cycles of an exact result.
-/// Corners of a facet closer than kFeatureTolerance times the diagonal are merged (each
-/// cluster keeps its lowest-index vertex). When nothing merges, the facets are used as
-/// they are. Otherwise the mesh is rebuilt as the exact convex hull of the merged points,
-/// its triangles grouped back into the result's facets (a triangle belongs to the facet
-/// all three of its corners came from): closed and convex by construction, facets kept
-/// as polygons. `source` (optional) receives, per output face, its facet index.
+/// Builds the output mesh from rounded points and facet cycles of an exact result,
+/// merging what lies below kFeatureTolerance times the diagonal: corners of a facet that
+/// close (each cluster keeps its lowest-index vertex); adjacent facets coplanar to within
+/// it, and needles (facets thinner than it) with a neighbour they lie flat on, into one
+/// polygon; vertices left with fewer than three facets around them. When the merged
+/// cycles are not a closed manifold of convex polygons, the exact convex hull of the
+/// points (exact predicates on the doubles) is grouped the same way instead. Linear in
+/// the result's size except in that fallback. `source` (optional) receives, per output
+/// face, its facet index (of its largest member when facets merged; -1 for none).
 Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& face_begin,
                 const std::vector<int>& corners, std::vector<int>* source);
 

@@ -89,6 +89,12 @@ double max_excess(const Description& inner, const Description& outer);
 /// has any only to within the feature size.
 std::string subresolution_feature(const Description& d, double tol);
 
+/// The library's feature size (kFeatureTolerance = 1e-11 of the diagonal) with margin, for
+/// finding features of an exact set that it merges; and half of it, for finding features
+/// a result must not keep.
+inline constexpr double kLibraryFeatureTolerance = 2e-11;
+inline constexpr double kResultFeatureTolerance = 0.5e-11;
+
 /// True when every face of the mesh is exactly planar (exact orientation tests).
 bool exactly_planar(const Mesh& mesh);
 
