@@ -1,7 +1,8 @@
 // Private: number types and filtered exact predicates used by every combinatorial
 // decision of libmorph. A predicate is evaluated first in interval arithmetic; only
 // when the interval contains zero is it evaluated again with exact rationals. No
-// decision ever uses an epsilon.
+// decision ever uses an epsilon. (The predicates on facet normals, see polytope.h, filter
+// with doubles and error bounds instead of intervals.)
 #pragma once
 
 #include <CGAL/Gmpq.h>
@@ -75,16 +76,6 @@ inline int interval_sign(const Interval& v) {
   if (v.sup() < 0) return -1;
   if (v.inf() == 0 && v.sup() == 0) return 0;
   return 2;
-}
-
-/// The filtered evaluation of a polynomial predicate: `f` is a generic callable applied to
-/// interval arguments first and to exact arguments only when that cannot decide.
-/// Each argument `a` provides a.approx() (V3<Interval>) and a.exact() (V3<Exact>).
-template <class F, class... Args>
-inline int filtered_sign(const F& f, const Args&... args) {
-  const int s = interval_sign(f(args.approx()...));
-  if (s != 2) return s;
-  return CGAL::sign(f(args.exact()...));
 }
 
 inline V3<Interval> to_interval(const V3<double>& p) { return {Interval(p.x), Interval(p.y), Interval(p.z)}; }

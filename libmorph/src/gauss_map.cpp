@@ -10,14 +10,9 @@ namespace morph::detail {
 
 namespace {
 
-const auto kDet = [](const auto& a, const auto& b, const auto& c) { return det(a, b, c); };
-const auto kCrossDot = [](const auto& a, const auto& b, const auto& c, const auto& d) {
-  return cross_dot(a, b, c, d);
-};
-
 /// X lies on the closed arc (p, q), given that it lies on the great circle through them.
 bool between(const NormalRef& p, const NormalRef& x, const NormalRef& q) {
-  return filtered_sign(kCrossDot, p, x, p, q) >= 0 && filtered_sign(kCrossDot, x, q, p, q) >= 0;
+  return cross_dot_normals(p, x, p, q) >= 0 && cross_dot_normals(x, q, p, q) >= 0;
 }
 
 /// Signs of det(N_fan[i], N_fan[i+1], p) for the slots of v's region, walking on at the
@@ -48,8 +43,6 @@ Location classify(const Polytope& P, int v, const int zeros[2], int nzeros) {
 }
 
 }  // namespace
-
-int orient(const NormalRef& a, const NormalRef& b, const NormalRef& c) { return filtered_sign(kDet, a, b, c); }
 
 Location locate(const Polytope& P, const NormalRef& p, int hint) {
   int v = hint;
@@ -84,7 +77,6 @@ int location_vertex(const Polytope& P, const Location& loc) {
 std::vector<Location> locate_all(const Polytope& from, const Polytope& in) {
   std::vector<Location> loc(from.num_faces());
   parallel_chunks(from.num_faces(), 256, [&](int begin, int end) {
-    RoundingGuard guard;
     int hint = 0;
     for (int f = begin; f < end; ++f) {
       loc[f] = locate(in, NormalRef{&from, f}, hint);
@@ -94,9 +86,9 @@ std::vector<Location> locate_all(const Polytope& from, const Polytope& in) {
   return loc;
 }
 
-ArcContact arc_contact(const NormalRef& n1, const NormalRef& n2, const NormalRef& m1, const NormalRef& m2) {
+ArcContact arc_contact(const NormalRef& n1, const NormalRef& n2, const NormalRef& m1, const NormalRef& m2, int s1,
+                       int s2) {
   ArcContact c;
-  const int s1 = orient(n1, n2, m1), s2 = orient(n1, n2, m2);
   if (s1 == 0 && s2 == 0) {  // on one great circle: touching iff they overlap
     c.touches = between(n1, m1, n2) || between(n1, m2, n2) || between(m1, n1, m2);
     return c;
@@ -153,14 +145,16 @@ void overlay_regions(const NormalRef& p, const std::vector<Arc>& x_arcs, const s
     const int s = orient(p, r, q);
     if (s > 0) return 1;
     if (s < 0) return 3;
-    return filtered_sign(kCrossDot, p, r, p, q) > 0 ? 0 : 2;
+    return cross_dot_normals(p, r, p, q) > 0 ? 0 : 2;
   };
   auto compare = [&](const NormalRef& q1, int h1, const NormalRef& q2, int h2) {
     if (h1 != h2) return h1 < h2 ? -1 : 1;
     if (h1 == 0 || h1 == 2) return 0;
     return -orient(p, q1, q2);  // q1 before q2 when q2 is counter-clockwise of q1
   };
-  std::vector<int> hx(nx), hy(ny);
+  thread_local std::vector<int> hx, hy;  // reused: this runs once per facet of the result
+  hx.resize(nx);
+  hy.resize(ny);
   for (int i = 0; i < nx; ++i) hx[i] = i == 0 ? 0 : half(x_arcs[i].to);
   for (int j = 0; j < ny; ++j) hy[j] = half(y_arcs[j].to);
   // The y arcs are cyclically sorted: start at the smallest angle.

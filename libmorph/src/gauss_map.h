@@ -15,7 +15,7 @@ struct Location {
 };
 
 /// Sign of det(a, b, c) for three normals.
-int orient(const NormalRef& a, const NormalRef& b, const NormalRef& c);
+inline int orient(const NormalRef& a, const NormalRef& b, const NormalRef& c) { return orient_normals(a, b, c); }
 
 /// Locates the direction `p` in P's Gauss map: the vertex whose region contains it in
 /// its interior (the contributing vertex), the edge whose arc contains it, or the facet
@@ -37,7 +37,10 @@ struct ArcContact {
   bool crosses = false;  // they cross at a point interior to both
   int side = 0;          // when crossing: sign of det(n1, n2, m2) (where m2 lies)
 };
-ArcContact arc_contact(const NormalRef& n1, const NormalRef& n2, const NormalRef& m1, const NormalRef& m2);
+/// s1 and s2 are orient(n1, n2, m1) and orient(n1, n2, m2), which a caller testing many
+/// arcs against one computes once per normal.
+ArcContact arc_contact(const NormalRef& n1, const NormalRef& n2, const NormalRef& m1, const NormalRef& m2, int s1,
+                       int s2);
 
 /// An arc of a Gauss map leaving a point, toward the normal `to`, followed
 /// counter-clockwise by the region of vertex `after`.

@@ -32,46 +32,81 @@ Element element_of(const Polytope& P, const Location& loc) {
   return {};
 }
 
-/// A facet under construction.
-struct Facet {
-  std::vector<std::pair<int, int>> corners;
-  FacetOrigin origin;
+/// The facets found by one chunk of a loop, in loop order.
+struct FacetBuffer {
+  std::vector<int> sizes;
+  std::vector<std::uint64_t> corners;
+  std::vector<FacetOrigin> origins;
+  std::vector<std::pair<int, int>> pairs;  // scratch
+  std::vector<Arc> x_arcs, y_arcs;        // scratch
+
+  void add(const FacetOrigin& origin) {
+    for (const auto& [i, j] : pairs) corners.push_back(pair_key(i, j));
+    sizes.push_back(static_cast<int>(pairs.size()));
+    origins.push_back(origin);
+  }
 };
+
+/// Runs body(begin, end, buffer) over [0, n) in fixed chunks (in parallel) and returns
+/// the chunks' buffers in order, so the result does not depend on the thread count.
+template <class Body>
+std::vector<FacetBuffer> in_chunks(int n, const Body& body) {
+  const int chunks = (n + kGrain - 1) / kGrain;
+  std::vector<FacetBuffer> buffers(chunks);
+  parallel_chunks(chunks, 1, [&](int first, int last) {
+    for (int c = first; c < last; ++c) body(c * kGrain, std::min(n, (c + 1) * kGrain), buffers[c]);
+  });
+  return buffers;
+}
 
 /// The facet of A (+) B whose normal is the normal of facet f of X (X is A when
 /// x_is_a), located at `loc` in Y's Gauss map.
 void facet_at_normal(const Polytope& X, int f, const Polytope& Y, const Location& loc, bool x_is_a,
-                     std::vector<Arc>& x_arcs, std::vector<Arc>& y_arcs, Facet& out) {
-  arcs_around(X, {Location::Kind::face, f}, x_arcs);
-  arcs_around(Y, loc, y_arcs);
-  out.corners.clear();
-  overlay_regions(NormalRef{&X, f}, x_arcs, y_arcs, loc.index, out.corners);
+                     FacetBuffer& out) {
+  arcs_around(X, {Location::Kind::face, f}, out.x_arcs);
+  arcs_around(Y, loc, out.y_arcs);
+  out.pairs.clear();
+  overlay_regions(NormalRef{&X, f}, out.x_arcs, out.y_arcs, loc.index, out.pairs);
   if (!x_is_a)
-    for (auto& c : out.corners) std::swap(c.first, c.second);
+    for (auto& c : out.pairs) std::swap(c.first, c.second);
   const Element ex{Element::Kind::facet, X.face_source[f]};
   const Element ey = element_of(Y, loc);
-  out.origin = x_is_a ? FacetOrigin{FacetKind::translated, ex, ey} : FacetOrigin{FacetKind::corner, ey, ex};
+  out.add(x_is_a ? FacetOrigin{FacetKind::translated, ex, ey} : FacetOrigin{FacetKind::corner, ey, ex});
 }
 
-struct Crossing {
-  int edge_b;
-  int side;
+/// Per-thread marks for the walks of edge_facets, over B's elements.
+struct WalkScratch {
+  std::vector<int> region_stamp, edge_stamp, face_stamp;
+  std::vector<signed char> face_side;  // orient(n1, n2, N_g), valid when face_stamp[g] is current
+  std::vector<int> queue;
+  explicit WalkScratch(const Polytope& B)
+      : region_stamp(B.num_vertices(), 0), edge_stamp(B.num_edges(), 0), face_stamp(B.num_faces(), 0),
+        face_side(B.num_faces(), 0) {}
 };
 
-/// The edges of B whose arcs cross the arc of edge a of A, by a breadth-first walk over
-/// the regions of B that the arc touches, starting where the arc starts.
-void edge_crossings(const Polytope& A, int a, const Polytope& B, const Location& start,
-                    std::vector<int>& region_stamp, std::vector<int>& edge_stamp, std::vector<int>& queue,
-                    std::vector<Crossing>& out) {
+/// Appends the edge facets of edge a of A: for each edge of B whose arc the arc of a
+/// crosses (in B's edge order), the parallelogram a (+) b counter-clockwise about its
+/// outward normal. The crossings are found by a breadth-first walk over the regions of B
+/// that the arc touches, starting where the arc starts; each of B's normals is tested
+/// against the arc's great circle once.
+void edge_facets(const Polytope& A, int a, const Polytope& B, const Location& start, WalkScratch& w,
+                 FacetBuffer& out) {
   const auto& ea = A.edges[a];
   const NormalRef n1{&A, ea.left}, n2{&A, ea.right};
   const int stamp = a + 1;
-  queue.clear();
+  w.queue.clear();
   auto visit = [&](int v) {
-    if (region_stamp[v] != stamp) {
-      region_stamp[v] = stamp;
-      queue.push_back(v);
+    if (w.region_stamp[v] != stamp) {
+      w.region_stamp[v] = stamp;
+      w.queue.push_back(v);
     }
+  };
+  auto side = [&](int g) {
+    if (w.face_stamp[g] != stamp) {
+      w.face_stamp[g] = stamp;
+      w.face_side[g] = static_cast<signed char>(orient(n1, n2, NormalRef{&B, g}));
+    }
+    return static_cast<int>(w.face_side[g]);
   };
   switch (start.kind) {
     case Location::Kind::vertex:
@@ -85,37 +120,42 @@ void edge_crossings(const Polytope& A, int a, const Polytope& B, const Location&
       for (int k = 0; k < B.degree(start.index); ++k) visit(B.corner(start.index, k));
       break;
   }
-  for (std::size_t q = 0; q < queue.size(); ++q) {
-    const int v = queue[q];
+  std::vector<std::pair<int, int>>& crossings = out.pairs;  // (edge of B, side)
+  crossings.clear();
+  for (std::size_t q = 0; q < w.queue.size(); ++q) {
+    const int v = w.queue[q];
     for (int s = B.fan_begin[v]; s < B.fan_begin[v + 1]; ++s) {
       const int e = B.fan_edge[s];
-      if (edge_stamp[e] == stamp) continue;
-      edge_stamp[e] = stamp;
+      if (w.edge_stamp[e] == stamp) continue;
+      w.edge_stamp[e] = stamp;
       const auto& eb = B.edges[e];
-      const ArcContact c = arc_contact(n1, n2, NormalRef{&B, eb.left}, NormalRef{&B, eb.right});
-      if (c.crosses) out.push_back({e, c.side});
+      const ArcContact c =
+          arc_contact(n1, n2, NormalRef{&B, eb.left}, NormalRef{&B, eb.right}, side(eb.left), side(eb.right));
+      if (c.crosses) crossings.emplace_back(e, c.side);
       if (c.touches) visit(B.fan_vertex[s]);
     }
   }
-  std::sort(out.begin(), out.end(), [](const Crossing& x, const Crossing& y) { return x.edge_b < y.edge_b; });
+  std::sort(crossings.begin(), crossings.end());
+  const int ua = ea.from, wa = ea.to;
+  for (const auto& [e, side_of_b] : crossings) {
+    const int ub = B.edges[e].from, wb = B.edges[e].to;
+    const std::uint64_t quad[2][4] = {
+        {pair_key(wa, wb), pair_key(wa, ub), pair_key(ua, ub), pair_key(ua, wb)},   // side < 0
+        {pair_key(wa, ub), pair_key(wa, wb), pair_key(ua, wb), pair_key(ua, ub)}};  // side > 0
+    const auto& q = quad[side_of_b > 0];
+    out.corners.insert(out.corners.end(), q, q + 4);
+    out.sizes.push_back(4);
+    out.origins.push_back(
+        {FacetKind::edge, {Element::Kind::edge, A.edge_source[a]}, {Element::Kind::edge, B.edge_source[e]}});
+  }
 }
 
-/// The parallelogram a (+) b, counter-clockwise about its outward normal.
-void edge_facet(const Polytope& A, int a, const Polytope& B, const Crossing& c, Facet& out) {
-  const auto& ea = A.edges[a];
-  const auto& eb = B.edges[c.edge_b];
-  const int ua = ea.from, wa = ea.to, ub = eb.from, wb = eb.to;
-  if (c.side > 0)
-    out.corners = {{wa, ub}, {wa, wb}, {ua, wb}, {ua, ub}};
-  else
-    out.corners = {{wa, wb}, {wa, ub}, {ua, ub}, {ua, wb}};
-  out.origin = {FacetKind::edge, {Element::Kind::edge, A.edge_source[a]}, {Element::Kind::edge, B.edge_source[c.edge_b]}};
-}
-
-void append(SumFacets& out, const Facet& f) {
-  for (const auto& c : f.corners) out.corners.push_back(pair_key(c.first, c.second));
-  out.face_begin.push_back(static_cast<int>(out.corners.size()));
-  out.origins.push_back(f.origin);
+void append(SumFacets& out, const std::vector<FacetBuffer>& buffers) {
+  for (const auto& b : buffers) {
+    for (int size : b.sizes) out.face_begin.push_back(out.face_begin.back() + size);
+    out.corners.insert(out.corners.end(), b.corners.begin(), b.corners.end());
+    out.origins.insert(out.origins.end(), b.origins.begin(), b.origins.end());
+  }
 }
 
 }  // namespace
@@ -125,50 +165,31 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
   const std::vector<Location> loc_b = locate_all(B, A);  // where B's facets sit on A
 
   // Translated facets: one per facet of A.
-  std::vector<Facet> translated(A.num_faces());
-  parallel_chunks(A.num_faces(), kGrain, [&](int begin, int end) {
-    RoundingGuard guard;
-    std::vector<Arc> xa, ya;
-    for (int f = begin; f < end; ++f) facet_at_normal(A, f, B, loc_a[f], true, xa, ya, translated[f]);
+  const auto translated = in_chunks(A.num_faces(), [&](int begin, int end, FacetBuffer& out) {
+    for (int f = begin; f < end; ++f) facet_at_normal(A, f, B, loc_a[f], true, out);
   });
   // Corner facets: one per facet of B whose normal is not also a facet normal of A.
-  std::vector<Facet> corner(B.num_faces());
-  parallel_chunks(B.num_faces(), kGrain, [&](int begin, int end) {
-    RoundingGuard guard;
-    std::vector<Arc> xa, ya;
+  const auto corner = in_chunks(B.num_faces(), [&](int begin, int end, FacetBuffer& out) {
     for (int g = begin; g < end; ++g)
-      if (loc_b[g].kind != Location::Kind::face) facet_at_normal(B, g, A, loc_b[g], false, xa, ya, corner[g]);
+      if (loc_b[g].kind != Location::Kind::face) facet_at_normal(B, g, A, loc_b[g], false, out);
   });
   // Edge facets: for every edge of A whose two facets have different contributing
   // vertices, the edges of B whose arcs its arc crosses.
-  std::vector<std::vector<Crossing>> crossings(A.num_edges());
-  struct Scratch {
-    std::vector<int> region_stamp, edge_stamp, queue;
-  };
-  tbb::enumerable_thread_specific<Scratch> scratch([&] {
-    return Scratch{std::vector<int>(B.num_vertices(), 0), std::vector<int>(B.num_edges(), 0), {}};
-  });
-  parallel_chunks(A.num_edges(), kGrain, [&](int begin, int end) {
-    RoundingGuard guard;
-    Scratch& s = scratch.local();
+  tbb::enumerable_thread_specific<WalkScratch> scratch([&] { return WalkScratch(B); });
+  const auto edge = in_chunks(A.num_edges(), [&](int begin, int end, FacetBuffer& out) {
+    WalkScratch& w = scratch.local();
     for (int a = begin; a < end; ++a) {
       const auto& l = loc_a[A.edges[a].left];
       const auto& r = loc_a[A.edges[a].right];
       if (l.kind == Location::Kind::vertex && r.kind == Location::Kind::vertex && l.index == r.index) continue;
-      edge_crossings(A, a, B, l, s.region_stamp, s.edge_stamp, s.queue, crossings[a]);
+      edge_facets(A, a, B, l, w, out);
     }
   });
 
   SumFacets out;
-  for (const auto& f : translated) append(out, f);
-  for (int g = 0; g < B.num_faces(); ++g)
-    if (loc_b[g].kind != Location::Kind::face) append(out, corner[g]);
-  Facet ef;
-  for (int a = 0; a < A.num_edges(); ++a)
-    for (const auto& c : crossings[a]) {
-      edge_facet(A, a, B, c, ef);
-      append(out, ef);
-    }
+  append(out, translated);
+  append(out, corner);
+  append(out, edge);
   return out;
 }
 

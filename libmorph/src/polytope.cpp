@@ -6,6 +6,8 @@
 #include <mpfr.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <numeric>
 #include <string>
 #include <unordered_map>
@@ -68,7 +70,30 @@ void Polytope::compute_normals() {
                                            [&](int i) -> const V3<Interval>& { return cycle[i]; });
     }
   }
+  // Unit vectors: the midpoint m of each enclosure, normalised. The exact normal n lies
+  // in the box, |n - m| <= r (its half-diagonal), hence |n/|n| - m/|m|| <= 2r/|m|; the
+  // normalisation adds a few ulps. Rounded upwards here, and with margins.
+  unit_normals.resize(nf);
+  for (int f = 0; f < nf; ++f) {
+    const V3<Interval>& n = normals[f];
+    const V3<double> m{0.5 * (n.x.inf() + n.x.sup()), 0.5 * (n.y.inf() + n.y.sup()), 0.5 * (n.z.inf() + n.z.sup())};
+    const V3<double> r{n.x.sup() - n.x.inf(), n.y.sup() - n.y.inf(), n.z.sup() - n.z.inf()};
+    const double length = std::sqrt(dot(m, m));
+    const double radius = 0.5 * std::sqrt(dot(r, r));
+    double error = 2 * radius / length * (1 + 1e-10) + 4e-15;
+    if (!(length > 0) || !std::isfinite(error) || error > 1) error = std::numeric_limits<double>::infinity();
+    unit_normals[f] = length > 0 ? UnitNormal{m.x / length, m.y / length, m.z / length, error}
+                                 : UnitNormal{0, 0, 0, error};
+  }
   exact_cache_ = std::make_shared<ExactCache>(nf);
+}
+
+int orient_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
+  return CGAL::sign(det(a.exact(), b.exact(), c.exact()));
+}
+
+int cross_dot_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef& c, const NormalRef& d) {
+  return CGAL::sign(cross_dot(a.exact(), b.exact(), c.exact(), d.exact()));
 }
 
 namespace {
@@ -194,10 +219,8 @@ void check_gauss_map(const Polytope& p, const char* name) {
     if (n < 3)
       fail(name, "vertex " + std::to_string(p.vertex_source[v]) + " has fewer than three facets");
     for (int i = 0; i < n; ++i) {
-      const int s = filtered_sign(
-          [](const auto& a, const auto& c, const auto& d) { return det(a, c, d); },
-          NormalRef{&p, p.fan_face[b + i]}, NormalRef{&p, p.fan_face[b + (i + 1) % n]},
-          NormalRef{&p, p.fan_face[b + (i + 2) % n]});
+      const int s = orient_normals(NormalRef{&p, p.fan_face[b + i]}, NormalRef{&p, p.fan_face[b + (i + 1) % n]},
+                                   NormalRef{&p, p.fan_face[b + (i + 2) % n]});
       if (s <= 0)
         fail(name, "the facets around vertex " + std::to_string(p.vertex_source[v]) +
                        " do not turn convexly (the mesh is not convex)");

@@ -26,6 +26,13 @@
 
 namespace morph::detail {
 
+/// A facet normal's direction rounded to a unit vector of doubles, and a bound on the
+/// Euclidean distance from it to the exact normal's unit vector (infinite when the
+/// normal's enclosure is too wide to tell its direction).
+struct UnitNormal {
+  double x, y, z, error;
+};
+
 struct Polytope {
   struct Edge {
     int from = -1, to = -1;    // vertices; `left` contains the directed edge from -> to
@@ -54,6 +61,9 @@ struct Polytope {
 
   // Interval Newell normals (computed under a RoundingGuard).
   std::vector<V3<Interval>> normals;
+  // The same normals as unit double vectors with error bounds: the fast filter of every
+  // predicate on normals (see orient_normals).
+  std::vector<UnitNormal> unit_normals;
 
   // Where each element came from in the operand mesh (labels): a representative face,
   // the vertex, a representative edge. -1 when not from a mesh.
@@ -76,7 +86,8 @@ struct Polytope {
   /// kept (thread-safe: racing threads may both compute it, all get the one kept).
   const V3<ExactN>& exact_normal(int f) const;
 
-  /// Computes `normals` and resets the exact cache; call after the facets are final.
+  /// Computes `normals` and `unit_normals` and resets the exact cache; call after the
+  /// facets are final.
   void compute_normals();
 
  private:
@@ -91,13 +102,51 @@ struct Polytope {
   mutable std::shared_ptr<ExactCache> exact_cache_;
 };
 
-/// A facet normal as a predicate argument (see filtered_sign).
+/// A facet normal as a predicate argument.
 struct NormalRef {
   const Polytope* polytope;
   int face;
-  const V3<Interval>& approx() const { return polytope->normals[face]; }
+  const UnitNormal& unit() const { return polytope->unit_normals[face]; }
   const V3<ExactN>& exact() const { return polytope->exact_normal(face); }
 };
+
+// Predicates on facet normals, the decisions of the FIMS kernel. Each is a semi-static
+// filter: evaluated in doubles on the unit normals, whose error bounds (plus the rounding
+// of the evaluation itself, in any rounding mode) bound the error of the value; only
+// when that cannot decide the sign is it evaluated exactly on the exact normals. Signs
+// are those of the exact normals (positive scalings do not change them).
+
+/// Bound on the rounding error of det or cross_dot of vectors of length at most
+/// 1 + 1e-15, evaluated in doubles with any rounding mode (each operation within one
+/// ulp): about 7e-15, doubled for safety.
+inline constexpr double kUnitPredicateRounding = 2e-14;
+
+int orient_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef& c);
+int cross_dot_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef& c, const NormalRef& d);
+
+/// Sign of det(N_a, N_b, N_c).
+inline int orient_normals(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
+  const UnitNormal &p = a.unit(), &q = b.unit(), &r = c.unit();
+  const double d = p.x * (q.y * r.z - q.z * r.y) + p.y * (q.z * r.x - q.x * r.z) + p.z * (q.x * r.y - q.y * r.x);
+  // det is 1-Lipschitz in each unit argument.
+  const double bound = p.error + q.error + r.error + kUnitPredicateRounding;
+  if (d > bound) return 1;
+  if (d < -bound) return -1;
+  return orient_normals_exact(a, b, c);
+}
+
+/// Sign of (N_a x N_b) . (N_c x N_d) = (N_a.N_c)(N_b.N_d) - (N_a.N_d)(N_b.N_c).
+inline int cross_dot_normals(const NormalRef& a, const NormalRef& b, const NormalRef& c, const NormalRef& d) {
+  const UnitNormal &p = a.unit(), &q = b.unit(), &r = c.unit(), &s = d.unit();
+  auto dot3 = [](const UnitNormal& u, const UnitNormal& v) { return u.x * v.x + u.y * v.y + u.z * v.z; };
+  const double value = dot3(p, r) * dot3(q, s) - dot3(p, s) * dot3(q, r);
+  // 2-Lipschitz in each unit argument; the second-order term covers errors up to 1.
+  const double e = p.error + q.error + r.error + s.error;
+  const double bound = 2 * e + 4 * e * e + kUnitPredicateRounding;
+  if (value > bound) return 1;
+  if (value < -bound) return -1;
+  return cross_dot_normals_exact(a, b, c, d);
+}
 
 /// How make_polytope reads a mesh's faces: as given, or each reversed (an inverted mesh,
 /// see check_operand).
