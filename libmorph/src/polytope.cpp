@@ -25,29 +25,124 @@ double round_to_nearest(const Exact& q) {
   return d;
 }
 
-Polytope::ExactCache::ExactCache(int n)
-    : slot(std::make_unique<std::atomic<const V3<ExactN>*>[]>(n)), size(n) {}
-
-Polytope::ExactCache::~ExactCache() {
-  for (int f = 0; f < size; ++f) delete slot[f].load(std::memory_order_relaxed);
-}
-
 const V3<ExactN>& Polytope::exact_normal(int f) const {
   if (!given_normals.empty()) return given_normals[f];
-  std::atomic<const V3<ExactN>*>& slot = exact_cache_->slot[f];
-  if (const V3<ExactN>* known = slot.load(std::memory_order_acquire)) return *known;
-  const int b = face_begin[f];
-  std::vector<V3<ExactN>> cycle;
-  cycle.reserve(degree(f));
-  for (int k = 0; k < degree(f); ++k) cycle.push_back(to_exact_n(points[corner_vertex[b + k]]));
-  auto computed = std::make_unique<const V3<ExactN>>(
-      newell_normal<ExactN>(degree(f), [&](int i) -> const V3<ExactN>& { return cycle[i]; }));
-  // Two threads may compute the same normal; the first to publish wins.
-  const V3<ExactN>* expected = nullptr;
-  if (slot.compare_exchange_strong(expected, computed.get(), std::memory_order_acq_rel,
-                                   std::memory_order_acquire))
-    return *computed.release();
-  return *expected;
+  return exact_cache_->get(f, [&] {
+    const int b = face_begin[f];
+    std::vector<V3<ExactN>> cycle;
+    cycle.reserve(degree(f));
+    for (int k = 0; k < degree(f); ++k) cycle.push_back(to_exact_n(points[corner_vertex[b + k]]));
+    return newell_normal<ExactN>(degree(f), [&](int i) -> const V3<ExactN>& { return cycle[i]; });
+  });
+}
+
+namespace {
+
+// Double-double arithmetic (Dekker, Knuth; as in Hida, Li and Bailey's QD library),
+// valid in round-to-nearest only. A value is hi + lo with |lo| <= ulp(hi) / 2. Each
+// operation below errs by at most 4u^2 (u = 2^-53) times the magnitude of its operands'
+// sum or product; the error bounds built on them are generous multiples of that.
+struct DD {
+  double hi, lo;
+};
+inline DD two_sum(double a, double b) {
+  const double s = a + b, bb = s - a;
+  return {s, (a - (s - bb)) + (b - bb)};
+}
+inline DD quick_two_sum(double a, double b) {
+  const double s = a + b;
+  return {s, b - (s - a)};
+}
+inline DD two_prod(double a, double b) {
+  const double p = a * b;
+  return {p, std::fma(a, b, -p)};
+}
+inline DD operator+(const DD& a, const DD& b) {
+  const DD s = two_sum(a.hi, b.hi);
+  return quick_two_sum(s.hi, s.lo + (a.lo + b.lo));
+}
+inline DD operator-(const DD& a) { return {-a.hi, -a.lo}; }
+inline DD operator-(const DD& a, const DD& b) { return a + -b; }
+inline DD operator*(const DD& a, const DD& b) {
+  const DD p = two_prod(a.hi, b.hi);
+  return quick_two_sum(p.hi, p.lo + (a.hi * b.lo + a.lo * b.hi));
+}
+constexpr double kU2 = 0x1p-106;  // u^2
+
+/// The precise normal of a facet with double points: the points scaled by a power of
+/// two (exactly) so the largest coordinate is about 1, Newell's sum in double-double. A
+/// component that might be zero is decided exactly (mirror-symmetric facets have exactly
+/// zero components, and predicates on them are then decided without exact arithmetic).
+PreciseNormal precise_newell(const std::vector<V3<double>>& points, const int* corners, int d) {
+  PreciseNormal n{};
+  double largest = 0;
+  for (int k = 0; k < d; ++k) {
+    const auto& p = points[corners[k]];
+    largest = std::max({largest, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+  }
+  if (!(largest > 0) || !std::isfinite(largest)) return n;
+  const int shift = -std::ilogb(largest);
+  const double scale = std::ldexp(1.0, shift), unscale = std::ldexp(1.0, -shift);
+  bool exact = true;
+  auto scaled = [&](double x) {
+    const double y = x * scale;  // exact unless it underflows
+    exact = exact && y * unscale == x;
+    return y;
+  };
+  DD sum[3] = {{0, 0}, {0, 0}, {0, 0}};
+  double magnitude[3] = {0, 0, 0};  // sum of |term|: bounds every partial sum
+  for (int k = 0; k < d; ++k) {
+    const auto& p0 = points[corners[k]];
+    const auto& q0 = points[corners[k + 1 == d ? 0 : k + 1]];
+    const double p[3] = {scaled(p0.x), scaled(p0.y), scaled(p0.z)};
+    const double q[3] = {scaled(q0.x), scaled(q0.y), scaled(q0.z)};
+    for (int i = 0; i < 3; ++i) {
+      // Component i: (p[j] - q[j]) (p[l] + q[l]) with (j, l) = (y, z), (z, x), (x, y).
+      const int j = (i + 1) % 3, l = (i + 2) % 3;
+      const DD diff = two_sum(p[j], -q[j]), total = two_sum(p[l], q[l]);  // exact
+      sum[i] = sum[i] + diff * total;
+      magnitude[i] += std::abs(diff.hi) * std::abs(total.hi);
+    }
+  }
+  if (!exact) return n;
+  for (int i = 0; i < 3; ++i) {
+    n.hi[i] = sum[i].hi;
+    n.lo[i] = sum[i].lo;
+    // d products and d additions, each within 4u^2 of magnitudes the sum of |term|
+    // bounds (|lo| adds 2u); doubled, plus an absolute term for underflow.
+    n.error[i] = 16 * (d + 1) * kU2 * magnitude[i] * 1.01 + 0x1p-1000;
+    if (std::abs(n.hi[i]) <= n.error[i]) {
+      const int j = (i + 1) % 3, l = (i + 2) % 3;
+      ExactN component(0);
+      for (int k = 0; k < d; ++k) {
+        const auto& p = points[corners[k]];
+        const auto& q = points[corners[k + 1 == d ? 0 : k + 1]];
+        const double pq[2][3] = {{p.x, p.y, p.z}, {q.x, q.y, q.z}};
+        component += (ExactN(pq[0][j]) - ExactN(pq[1][j])) * (ExactN(pq[0][l]) + ExactN(pq[1][l]));
+      }
+      if (CGAL::sign(component) == CGAL::ZERO) n.hi[i] = n.lo[i] = n.error[i] = 0;
+    }
+  }
+  n.valid = true;
+  return n;
+}
+
+/// Upper bound on the Euclidean length of a precise normal (the sum of |components|).
+double length_bound(const PreciseNormal& n) {
+  return (std::abs(n.hi[0]) + std::abs(n.hi[1]) + std::abs(n.hi[2])) * (1 + 1e-15) + n.error[0] + n.error[1] +
+         n.error[2];
+}
+
+/// Upper bound on the Euclidean length of a precise normal's error vector.
+double error_bound(const PreciseNormal& n) { return n.error[0] + n.error[1] + n.error[2]; }
+
+}  // namespace
+
+const PreciseNormal& Polytope::precise_normal(int f) const {
+  return precise_cache_->get(f, [&] {
+    if (!exact_points.empty()) return PreciseNormal{};
+    return precise_newell(points, &corner_vertex[face_begin[f]], degree(f));
+  });
 }
 
 void Polytope::compute_normals() {
@@ -85,10 +180,41 @@ void Polytope::compute_normals() {
     unit_normals[f] = length > 0 ? UnitNormal{m.x / length, m.y / length, m.z / length, error}
                                  : UnitNormal{0, 0, 0, error};
   }
-  exact_cache_ = std::make_shared<ExactCache>(nf);
+  exact_cache_ = std::make_shared<LazySlots<V3<ExactN>>>(nf);
+  precise_cache_ = std::make_shared<LazySlots<PreciseNormal>>(nf);
 }
 
 int orient_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
+  {
+    // Double-double needs round-to-nearest, whatever the caller set.
+    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    const PreciseNormal& p = a.polytope->precise_normal(a.face);
+    const PreciseNormal& q = b.polytope->precise_normal(b.face);
+    const PreciseNormal& r = c.polytope->precise_normal(c.face);
+    if (p.valid && q.valid && r.valid) {
+      // Three normals with the same zero component lie in one plane.
+      for (int i = 0; i < 3; ++i)
+        if (p.exactly_zero(i) && q.exactly_zero(i) && r.exactly_zero(i)) return 0;
+      auto dd = [](const PreciseNormal& n, int i) { return DD{n.hi[i], n.lo[i]}; };
+      auto minor = [&](int i, int j) { return dd(q, i) * dd(r, j) - dd(q, j) * dd(r, i); };
+      const DD value = dd(p, 0) * minor(1, 2) + dd(p, 1) * minor(2, 0) + dd(p, 2) * minor(0, 1);
+      // The evaluation: three levels of operations on terms bounded by the permanent.
+      double permanent = 0;
+      for (int i = 0; i < 3; ++i) {
+        const int j = (i + 1) % 3, l = (i + 2) % 3;
+        permanent += std::abs(p.hi[i]) * (std::abs(q.hi[j] * r.hi[l]) + std::abs(q.hi[l] * r.hi[j]));
+      }
+      // The inputs: det moves by at most |da| |b| |c| + |a'| |db| |c| + |a'| |b'| |dc|, with
+      // x' = x + dx.
+      const double la = length_bound(p), lb = length_bound(q), lc = length_bound(r);
+      const double da = error_bound(p), db = error_bound(q), dc = error_bound(r);
+      const double bound =
+          (da * lb * lc + (la + da) * db * lc + (la + da) * (lb + db) * dc + 64 * kU2 * permanent * 1.1) * 1.01 +
+          0x1p-1000;
+      if (value.hi > bound) return 1;
+      if (value.hi < -bound) return -1;
+    }
+  }
   return CGAL::sign(det(a.exact(), b.exact(), c.exact()));
 }
 

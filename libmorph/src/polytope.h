@@ -33,6 +33,17 @@ struct UnitNormal {
   double x, y, z, error;
 };
 
+/// A facet normal in double-double arithmetic (component i is hi[i] + lo[i]), times some
+/// power of two, within error[i] of the exact normal times that power in component i (a
+/// component that is exactly zero has error 0). Not `valid` when the facet's points are
+/// not doubles or do not scale exactly.
+struct PreciseNormal {
+  double hi[3], lo[3];
+  double error[3];
+  bool valid;
+  bool exactly_zero(int i) const { return error[i] == 0 && hi[i] == 0; }
+};
+
 struct Polytope {
   struct Edge {
     int from = -1, to = -1;    // vertices; `left` contains the directed edge from -> to
@@ -86,20 +97,40 @@ struct Polytope {
   /// kept (thread-safe: racing threads may both compute it, all get the one kept).
   const V3<ExactN>& exact_normal(int f) const;
 
-  /// Computes `normals` and `unit_normals` and resets the exact cache; call after the
-  /// facets are final.
+  /// Computes `normals` and `unit_normals` and resets the caches of exact and precise
+  /// normals; call after the facets are final.
   void compute_normals();
 
+ /// Newell's normal of facet f in double-double arithmetic, scaled by a power of two,
+  /// with an error bound: the second stage of the normal predicates. Computed on first
+  /// use and kept, as exact_normal.
+  const PreciseNormal& precise_normal(int f) const;
+
  private:
-  // One slot per facet, filled on first use: a few exact normals are ever needed, so
-  // nothing exact is allocated for the others.
-  struct ExactCache {
-    explicit ExactCache(int n);
-    ~ExactCache();
-    std::unique_ptr<std::atomic<const V3<ExactN>*>[]> slot;
+  // One slot per facet, filled on first use (thread-safe: racing threads may both compute
+  // a value, all get the one kept): few facets ever need these, so nothing is allocated
+  // for the others.
+  template <class T>
+  struct LazySlots {
+    explicit LazySlots(int n) : slot(std::make_unique<std::atomic<const T*>[]>(n)), size(n) {}
+    ~LazySlots() {
+      for (int f = 0; f < size; ++f) delete slot[f].load(std::memory_order_relaxed);
+    }
+    template <class Compute>
+    const T& get(int f, const Compute& compute) {
+      if (const T* known = slot[f].load(std::memory_order_acquire)) return *known;
+      auto computed = std::make_unique<const T>(compute());
+      const T* expected = nullptr;  // the first to publish wins
+      if (slot[f].compare_exchange_strong(expected, computed.get(), std::memory_order_acq_rel,
+                                          std::memory_order_acquire))
+        return *computed.release();
+      return *expected;
+    }
+    std::unique_ptr<std::atomic<const T*>[]> slot;
     int size;
   };
-  mutable std::shared_ptr<ExactCache> exact_cache_;
+  mutable std::shared_ptr<LazySlots<V3<ExactN>>> exact_cache_;
+  mutable std::shared_ptr<LazySlots<PreciseNormal>> precise_cache_;
 };
 
 /// A facet normal as a predicate argument.
@@ -112,9 +143,11 @@ struct NormalRef {
 
 // Predicates on facet normals, the decisions of the FIMS kernel. Each is a semi-static
 // filter: evaluated in doubles on the unit normals, whose error bounds (plus the rounding
-// of the evaluation itself, in any rounding mode) bound the error of the value; only
-// when that cannot decide the sign is it evaluated exactly on the exact normals. Signs
-// are those of the exact normals (positive scalings do not change them).
+// of the evaluation itself, in any rounding mode) bound the error of the value. When that
+// cannot decide the sign, orient tries again in double-double arithmetic on precise
+// normals (nearly parallel facets of two fine spheres need it), and only then evaluates
+// exactly on the exact normals. Signs are those of the exact normals (positive scalings
+// do not change them).
 
 /// Bound on the rounding error of det or cross_dot of vectors of length at most
 /// 1 + 1e-15, evaluated in doubles with any rounding mode (each operation within one

@@ -1,0 +1,102 @@
+// Tests of the predicates on facet normals (libmorph/src/polytope.h), every decision of
+// the FIMS kernel: the double filter and the double-double stage must give the sign of
+// the exact evaluation, above all on the nearly degenerate triples that pairs of fine
+// spheres are full of (nearly parallel facets, mirror-symmetric facets).
+#include "../libmorph/src/polytope.h"
+
+#include <doctest/doctest.h>
+#include <morph/io.h>
+
+#include <CGAL/Mpzf.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include "support/polytopes.h"
+
+namespace {
+
+using morph::Mesh;
+using morph::detail::NormalRef;
+using morph::detail::Polytope;
+
+struct Tally {
+  int triples = 0, zero = 0, tiny = 0;  // tiny: |det| of the unit normals below 1e-13
+};
+
+/// For each facet of A, the `near` facets of B with the closest normals; every triple of
+/// A's facet and two of those, in both argument orders, against exact evaluation.
+void check_near_triples(const Polytope& A, const Polytope& B, int near, Tally& tally) {
+  std::vector<int> order(B.num_faces());
+  for (int f = 0; f < A.num_faces(); ++f) {
+    const auto& n = A.unit_normals[f];
+    std::iota(order.begin(), order.end(), 0);
+    std::partial_sort(order.begin(), order.begin() + near, order.end(), [&](int g, int h) {
+      const auto &u = B.unit_normals[g], &w = B.unit_normals[h];
+      return n.x * u.x + n.y * u.y + n.z * u.z > n.x * w.x + n.y * w.y + n.z * w.z;
+    });
+    const NormalRef a{&A, f};
+    for (int i = 0; i < near; ++i)
+      for (int j = i + 1; j < near; ++j) {
+        const NormalRef b{&B, order[i]}, c{&B, order[j]};
+        const int exact = CGAL::sign(morph::detail::det(a.exact(), b.exact(), c.exact()));
+        CHECK(morph::detail::orient_normals(a, b, c) == exact);
+        CHECK(morph::detail::orient_normals(b, a, c) == -exact);
+        CHECK(morph::detail::orient_normals(c, b, a) == -exact);
+        const int exact_cross = CGAL::sign(morph::detail::cross_dot(a.exact(), b.exact(), a.exact(), c.exact()));
+        CHECK(morph::detail::cross_dot_normals(a, b, a, c) == exact_cross);
+        ++tally.triples;
+        tally.zero += exact == 0;
+        const auto &p = a.unit(), &q = b.unit(), &r = c.unit();
+        const double d = p.x * (q.y * r.z - q.z * r.y) + p.y * (q.z * r.x - q.x * r.z) + p.z * (q.x * r.y - q.y * r.x);
+        tally.tiny += exact != 0 && std::abs(d) < 1e-13;
+      }
+  }
+}
+
+/// The rotation by `angle` about (1, 2, 3), row-major.
+std::vector<double> small_rotation(double angle) {
+  const double l = std::sqrt(14.0), x = 1 / l, y = 2 / l, z = 3 / l;
+  const double c = std::cos(angle), s = std::sin(angle), t = 1 - c;
+  return {t * x * x + c,     t * x * y - s * z, t * x * z + s * y,  //
+          t * x * y + s * z, t * y * y + c,     t * y * z - s * x,  //
+          t * x * z - s * y, t * y * z + s * x, t * z * z + c};
+}
+
+Mesh sample(const std::string& name) { return morph::read_mesh(std::string(MORPH_SAMPLES_DIR) + "/" + name); }
+
+}  // namespace
+
+TEST_CASE("normal predicates: the filters agree with exact evaluation on nearly degenerate triples") {
+  const Mesh ico320 = sample("icosphere_320.off"), ico1280 = sample("icosphere_1280.off");
+  struct Pair {
+    std::string what;
+    Mesh a, b;
+    bool degenerate = false;  // known to hold exactly coplanar and nearly coplanar triples
+  };
+  const std::vector<Pair> pairs = {
+      {"icosphere 320 and 1280 (nearly parallel and mirror-symmetric facets)", ico320, ico1280, true},
+      {"icosphere 1280 and a copy turned by 1e-12", ico1280,
+       morph::test::transformed(ico1280, small_rotation(1e-12))},
+      {"tiny and huge copies", morph::test::scaled(ico320, 1e-60), morph::test::scaled(ico1280, 1e60)},
+      {"integer polytopes", morph::test::random_integer_polytope(60, 3, 4),
+       morph::test::random_integer_polytope(60, 4, 4)},
+  };
+  for (const auto& pair : pairs) {
+    CAPTURE(pair.what);
+    const Polytope A = morph::detail::make_operand(pair.a, "A");
+    const Polytope B = morph::detail::make_operand(pair.b, "B");
+    Tally tally;
+    check_near_triples(A, B, 6, tally);
+    MESSAGE(pair.what << ": " << tally.triples << " triples, " << tally.zero << " exactly coplanar, " << tally.tiny
+                      << " nonzero below the double filter");
+    CHECK(tally.triples > 0);
+    if (pair.degenerate) {
+      CHECK(tally.zero > 0);
+      CHECK(tally.tiny > 0);
+    }
+  }
+}
