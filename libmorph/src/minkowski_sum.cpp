@@ -151,6 +151,11 @@ void edge_facets(const Polytope& A, int a, const Polytope& B, const Location& st
 }
 
 void append(SumFacets& out, const std::vector<FacetBuffer>& buffers) {
+  std::size_t faces = out.origins.size(), corners = out.corners.size();
+  for (const auto& b : buffers) faces += b.origins.size(), corners += b.corners.size();
+  out.face_begin.reserve(faces + 1);
+  out.origins.reserve(faces);
+  out.corners.reserve(corners);
   for (const auto& b : buffers) {
     for (int size : b.sizes) out.face_begin.push_back(out.face_begin.back() + size);
     out.corners.insert(out.corners.end(), b.corners.begin(), b.corners.end());
