@@ -45,7 +45,27 @@ Location classify(const Polytope& P, int v, const int zeros[2], int nzeros) {
 }  // namespace
 
 Location locate(const Polytope& P, const NormalRef& p, int hint) {
+  // First a cheap climb in doubles: to the neighbour with the largest support value
+  // <p, x>, while it strictly grows (so it ends). It only picks where the exact walk
+  // starts, which then usually finds the region at once.
   int v = hint;
+  {
+    const UnitNormal& d = p.unit();
+    auto support = [&](int w) { return d.x * P.points[w].x + d.y * P.points[w].y + d.z * P.points[w].z; };
+    double best = support(v);
+    for (bool moved = true; moved;) {
+      moved = false;
+      const int from = v;
+      for (int s = P.fan_begin[from]; s < P.fan_begin[from + 1]; ++s) {
+        const double h = support(P.fan_vertex[s]);
+        if (h > best) {
+          best = h;
+          v = P.fan_vertex[s];
+          moved = true;
+        }
+      }
+    }
+  }
   int zeros[2];
   int nzeros = 0;
   const int limit = P.num_vertices() + 16;
