@@ -53,9 +53,15 @@ inline DD quick_two_sum(double a, double b) {
   const double s = a + b;
   return {s, b - (s - a)};
 }
-inline DD two_prod(double a, double b) {
+inline DD split(double a) {  // Veltkamp: a = hi + lo with 26-bit halves (|a| < 2^995)
+  const double c = 134217729.0 * a;  // 2^27 + 1
+  const double hi = c - (c - a);
+  return {hi, a - hi};
+}
+inline DD two_prod(double a, double b) {  // Dekker; inline, unlike a call to std::fma
   const double p = a * b;
-  return {p, std::fma(a, b, -p)};
+  const DD x = split(a), y = split(b);
+  return {p, ((x.hi * y.hi - p) + x.hi * y.lo + x.lo * y.hi) + x.lo * y.lo};
 }
 inline DD operator+(const DD& a, const DD& b) {
   const DD s = two_sum(a.hi, b.hi);
@@ -91,26 +97,47 @@ PreciseNormal precise_newell(const std::vector<V3<double>>& points, const int* c
   };
   DD sum[3] = {{0, 0}, {0, 0}, {0, 0}};
   double magnitude[3] = {0, 0, 0};  // sum of |term|: bounds every partial sum
-  for (int k = 0; k < d; ++k) {
-    const auto& p0 = points[corners[k]];
-    const auto& q0 = points[corners[k + 1 == d ? 0 : k + 1]];
+  int operations = 0;               // dd operations along each component's sum
+  if (d == 3) {
+    // A triangle's Newell normal is the cross product of two edges (fewer operations).
+    const auto &p0 = points[corners[0]], &q0 = points[corners[1]], &r0 = points[corners[2]];
     const double p[3] = {scaled(p0.x), scaled(p0.y), scaled(p0.z)};
     const double q[3] = {scaled(q0.x), scaled(q0.y), scaled(q0.z)};
+    const double r[3] = {scaled(r0.x), scaled(r0.y), scaled(r0.z)};
+    DD a[3], b[3];
     for (int i = 0; i < 3; ++i) {
-      // Component i: (p[j] - q[j]) (p[l] + q[l]) with (j, l) = (y, z), (z, x), (x, y).
-      const int j = (i + 1) % 3, l = (i + 2) % 3;
-      const DD diff = two_sum(p[j], -q[j]), total = two_sum(p[l], q[l]);  // exact
-      sum[i] = sum[i] + diff * total;
-      magnitude[i] += std::abs(diff.hi) * std::abs(total.hi);
+      a[i] = two_sum(q[i], -p[i]);  // exact
+      b[i] = two_sum(r[i], -p[i]);
     }
+    for (int i = 0; i < 3; ++i) {
+      const int j = (i + 1) % 3, l = (i + 2) % 3;
+      sum[i] = a[j] * b[l] - a[l] * b[j];
+      magnitude[i] = std::abs(a[j].hi) * std::abs(b[l].hi) + std::abs(a[l].hi) * std::abs(b[j].hi);
+    }
+    operations = 3;
+  } else {
+    for (int k = 0; k < d; ++k) {
+      const auto& p0 = points[corners[k]];
+      const auto& q0 = points[corners[k + 1 == d ? 0 : k + 1]];
+      const double p[3] = {scaled(p0.x), scaled(p0.y), scaled(p0.z)};
+      const double q[3] = {scaled(q0.x), scaled(q0.y), scaled(q0.z)};
+      for (int i = 0; i < 3; ++i) {
+        // Component i: (p[j] - q[j]) (p[l] + q[l]) with (j, l) = (y, z), (z, x), (x, y).
+        const int j = (i + 1) % 3, l = (i + 2) % 3;
+        const DD diff = two_sum(p[j], -q[j]), total = two_sum(p[l], q[l]);  // exact
+        sum[i] = sum[i] + diff * total;
+        magnitude[i] += std::abs(diff.hi) * std::abs(total.hi);
+      }
+    }
+    operations = 2 * d;
   }
   if (!exact) return n;
   for (int i = 0; i < 3; ++i) {
     n.hi[i] = sum[i].hi;
     n.lo[i] = sum[i].lo;
-    // d products and d additions, each within 4u^2 of magnitudes the sum of |term|
-    // bounds (|lo| adds 2u); doubled, plus an absolute term for underflow.
-    n.error[i] = 16 * (d + 1) * kU2 * magnitude[i] * 1.01 + 0x1p-1000;
+    // Each operation errs by at most 4u^2 times magnitudes that the sum of |term| bounds
+    // (|lo| adds 2u); doubled, plus an absolute term for underflow.
+    n.error[i] = 8 * (operations + 1) * kU2 * magnitude[i] * 1.01 + 0x1p-1000;
     if (std::abs(n.hi[i]) <= n.error[i]) {
       const int j = (i + 1) % 3, l = (i + 2) % 3;
       ExactN component(0);
