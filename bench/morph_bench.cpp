@@ -3,14 +3,15 @@
 //   morph-bench                  Table 1, morphology rows, quick scaling (a few minutes at most)
 //   morph-bench --table1         Table 1 of the FIMS paper: libmorph against the hull route
 //   morph-bench --morphology     erosion, opening and closing on the Table 1 operands
-//   morph-bench --scaling        full scaling to >= 300,000 input facets, log-log slope, peak memory
-//   morph-bench --all            all of the above with the full scaling
+//   morph-bench --scaling        full scaling to >= 300,000 input facets, log-log slope, peak
+//   memory morph-bench --all            all of the above with the full scaling
 //   --csv DIR                    also write table1.csv, morphology.csv, scaling.csv into DIR
 //   --markdown FILE              also write the report (Markdown tables) to FILE
 //   --samples DIR                where the sample meshes are (default: the source tree's samples/)
 //   --budget SECONDS             time aimed at per measurement, repetitions included (default 1)
 //   --filter TEXT                Table 1 and morphology: only the pairs whose "A + B" contains TEXT
-//   --loop A B SECONDS [THREADS] only A (+) B with libmorph, repeated for SECONDS (for perf record);
+//   --loop A B SECONDS [THREADS] only A (+) B with libmorph, repeated for SECONDS (for perf
+//   record);
 //                                A and B are sample files, B = "rotated" is A turned as in Table 1
 //   --op erode|open|close        before --loop: loop this operation instead (B scaled as in the
 //                                morphology rows)
@@ -53,7 +54,7 @@ using morph::Mesh;
 // Rotation of the second operand in the "rotated icosphere" cases: small enough that the
 // sum stays close to the aligned one, large enough that no facet of A is parallel to one
 // of B (the aligned sum of two equal icospheres is degenerate: every facet coincides).
-constexpr double kRotationAngle = 0.01;  // radians, about kRotationAxis
+constexpr double kRotationAngle = 0.01;               // radians, about kRotationAxis
 constexpr double kRotationAxis[3] = {1.0, 2.0, 3.0};  // generic; normalised before use
 
 // The morphology rows scale B by this factor: the samples all have radius about 1, and
@@ -70,7 +71,7 @@ struct Settings {
   bool scaling = false;
   bool full_scaling = false;
   std::filesystem::path samples = MORPH_SAMPLES_DIR;
-  std::filesystem::path csv_dir;  // empty: no CSV
+  std::filesystem::path csv_dir;   // empty: no CSV
   std::filesystem::path markdown;  // empty: no file
   std::string filter;              // Table 1 / morphology pairs whose "A + B" contains it
   std::string loop_op = "sum";     // what --loop repeats: sum, erode, open, close
@@ -126,9 +127,11 @@ long peak_rss_kib() {
 // Operands
 
 Mesh rotated(const Mesh& mesh, double angle) {
-  const double norm = std::sqrt(kRotationAxis[0] * kRotationAxis[0] +
-                                kRotationAxis[1] * kRotationAxis[1] + kRotationAxis[2] * kRotationAxis[2]);
-  const double x = kRotationAxis[0] / norm, y = kRotationAxis[1] / norm, z = kRotationAxis[2] / norm;
+  const double norm =
+      std::sqrt(kRotationAxis[0] * kRotationAxis[0] + kRotationAxis[1] * kRotationAxis[1] +
+                kRotationAxis[2] * kRotationAxis[2]);
+  const double x = kRotationAxis[0] / norm, y = kRotationAxis[1] / norm,
+               z = kRotationAxis[2] / norm;
   const double c = std::cos(angle), s = std::sin(angle), t = 1.0 - c;
   const double r[3][3] = {{t * x * x + c, t * x * y - s * z, t * x * z + s * y},
                           {t * x * y + s * z, t * y * y + c, t * y * z - s * x},
@@ -159,7 +162,8 @@ Mesh to_mesh(const HullMesh& hull) {
   std::vector<Mesh::VertexHandle> face;
   for (auto f : hull.faces()) {
     face.clear();
-    for (auto v : CGAL::vertices_around_face(hull.halfedge(f), hull)) face.push_back(handle[v.idx()]);
+    for (auto v : CGAL::vertices_around_face(hull.halfedge(f), hull))
+      face.push_back(handle[v.idx()]);
     mesh.add_face(face);
   }
   return mesh;
@@ -334,8 +338,8 @@ void run_table1(const std::vector<Pair>& pairs, const Settings& settings, Report
   Table table{"Table 1: A (+) B, libmorph against the hull route",
               "table1.csv",
               {"A (facets)", "B (facets)", "libmorph 1 thread (ms)", "libmorph all threads (ms)",
-               "hull route (ms)", "hull / libmorph (1 thread)", "hull / libmorph (all threads)", "libmorph V / F",
-               "hull V / triangles", "reps lib / hull"},
+               "hull route (ms)", "hull / libmorph (1 thread)", "hull / libmorph (all threads)",
+               "libmorph V / F", "hull V / triangles", "reps lib / hull"},
               {},
               {}};
   for (const auto& [a, b] : pairs) {
@@ -346,7 +350,8 @@ void run_table1(const std::vector<Pair>& pairs, const Settings& settings, Report
     const Timing ref = time_median([&] { hull = hull_route(a.mesh, b.mesh); }, settings);
     table.rows.push_back({operand_cell(a), operand_cell(b), ms(one.median_ms), ms(all.median_ms),
                           ms(ref.median_ms), ratio(ref.median_ms / one.median_ms),
-                          ratio(ref.median_ms / all.median_ms), std::to_string(lib.vertices) + " / " + std::to_string(lib.facets),
+                          ratio(ref.median_ms / all.median_ms),
+                          std::to_string(lib.vertices) + " / " + std::to_string(lib.facets),
                           std::to_string(hull.vertices) + " / " + std::to_string(hull.facets),
                           std::to_string(one.reps) + " / " + std::to_string(ref.reps)});
   }
@@ -354,7 +359,8 @@ void run_table1(const std::vector<Pair>& pairs, const Settings& settings, Report
       "Median times in milliseconds, warm-up excluded. libmorph: `morph::minkowski_sum` "
       "(operand validation included), facets kept as polygons. Hull route: all |A||B| vertex "
       "sums, `CGAL::convex_hull_3` (Epick) into a `Surface_mesh` (triangles). The rotated "
-      "icosphere is turned by " + fixed(kRotationAngle, 2) + " rad about (1, 2, 3).");
+      "icosphere is turned by " +
+      fixed(kRotationAngle, 2) + " rad about (1, 2, 3).");
   report.table(table);
 }
 
@@ -382,14 +388,16 @@ void run_morphology(const std::vector<Pair>& pairs, const Settings& settings, Re
   }
   table.header.push_back("facets erode / open / close");
   for (const auto& [a, b_full] : pairs) {
-    const Operand b{b_full.name + " x" + fixed(kMorphologyScale, 2), scaled(b_full.mesh, kMorphologyScale)};
+    const Operand b{b_full.name + " x" + fixed(kMorphologyScale, 2),
+                    scaled(b_full.mesh, kMorphologyScale)};
     std::cerr << "  morphology: " << a.name << " by " << b.name << '\n';
     std::vector<std::string> row{operand_cell(a), operand_cell(b)};
     std::string facets;
     for (const auto& [name, op] : ops) {
       morph::MorphResult result;
       for (int threads : {1, 0}) {
-        const Timing t = time_median([&] { result = op(a.mesh, b.mesh, {.threads = threads}); }, settings);
+        const Timing t =
+            time_median([&] { result = op(a.mesh, b.mesh, {.threads = threads}); }, settings);
         row.push_back(ms(t.median_ms));
       }
       facets += (facets.empty() ? "" : " / ") + result_cell(result);
@@ -425,9 +433,11 @@ ScalingCase make_case(const std::string& series, int parameter) {
     return {series, parameter, std::move(a), std::move(b)};
   }
   if (series == kFixedSmall)
-    return {series, parameter, morph::make_icosphere(1.0, parameter), morph::make_icosphere(0.5, 1)};
+    return {series, parameter, morph::make_icosphere(1.0, parameter),
+            morph::make_icosphere(0.5, 1)};
   if (series == kRandom)
-    return {series, parameter, random_polytope(parameter, kSeedA), random_polytope(parameter, kSeedB)};
+    return {series, parameter, random_polytope(parameter, kSeedA),
+            random_polytope(parameter, kSeedB)};
   throw std::runtime_error("unknown scaling series: " + series);
 }
 
@@ -441,7 +451,9 @@ std::vector<ScalingPlan> scaling_plan(bool full) {
     return {{kSameLevel, {1, 2, 3, 4, 5, 6, 7}},
             {kFixedSmall, {1, 2, 3, 4, 5, 6, 7}},
             {kRandom, {50, 200, 800, 3200, 12800, 51200, 160000}}};
-  return {{kSameLevel, {1, 2, 3, 4, 5}}, {kFixedSmall, {1, 2, 3, 4, 5}}, {kRandom, {50, 200, 800, 3200, 12800}}};
+  return {{kSameLevel, {1, 2, 3, 4, 5}},
+          {kFixedSmall, {1, 2, 3, 4, 5}},
+          {kRandom, {50, 200, 800, 3200, 12800}}};
 }
 
 // Least-squares slope of log(y) against log(x).
@@ -462,26 +474,30 @@ std::string peak_memory(const std::string& series, int parameter) {
   const ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);
   if (len <= 0) return "unavailable";
   exe[len] = '\0';
-  const std::string command = "'" + std::string(exe) + "' --peak-case '" + series + "' " + std::to_string(parameter);
+  const std::string command =
+      "'" + std::string(exe) + "' --peak-case '" + series + "' " + std::to_string(parameter);
   FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) return "unavailable";
   long before = 0, after = 0;
   const int got = std::fscanf(pipe, "%ld %ld", &before, &after);
   pclose(pipe);
   if (got != 2) return "unavailable";
-  return fixed(after / 1024.0, 0) + " MiB peak resident (operands alone: " + fixed(before / 1024.0, 0) + " MiB)";
+  return fixed(after / 1024.0, 0) +
+         " MiB peak resident (operands alone: " + fixed(before / 1024.0, 0) + " MiB)";
 }
 
 // Repeats one libmorph sum for a while, for a profiler to sample.
-int run_loop(const Settings& settings, const std::string& a_file, const std::string& b_file, double seconds,
-             int threads) {
+int run_loop(const Settings& settings, const std::string& a_file, const std::string& b_file,
+             double seconds, int threads) {
   const Mesh a = morph::read_mesh(settings.samples / a_file);
-  Mesh b = b_file == "rotated" ? rotated(a, kRotationAngle) : morph::read_mesh(settings.samples / b_file);
-  const auto op = settings.loop_op == "erode" ? &morph::erode
-                  : settings.loop_op == "open" ? &morph::open
+  Mesh b = b_file == "rotated" ? rotated(a, kRotationAngle)
+                               : morph::read_mesh(settings.samples / b_file);
+  const auto op = settings.loop_op == "erode"   ? &morph::erode
+                  : settings.loop_op == "open"  ? &morph::open
                   : settings.loop_op == "close" ? &morph::close
                                                 : nullptr;
-  if (!op && settings.loop_op != "sum") throw std::runtime_error("unknown --op " + settings.loop_op);
+  if (!op && settings.loop_op != "sum")
+    throw std::runtime_error("unknown --op " + settings.loop_op);
   if (op) b = scaled(b, kMorphologyScale);
   const auto start = Clock::now();
   int runs = 0;
@@ -495,8 +511,8 @@ int run_loop(const Settings& settings, const std::string& a_file, const std::str
     }
     ++runs;
   }
-  std::printf("%d runs, %.3f ms each, %zu vertices, %zu facets\n", runs, milliseconds_since(start) / runs,
-              out.vertices, out.facets);
+  std::printf("%d runs, %.3f ms each, %zu vertices, %zu facets\n", runs,
+              milliseconds_since(start) / runs, out.vertices, out.facets);
   return 0;
 }
 
@@ -509,11 +525,13 @@ int run_peak_case(const std::string& series, int parameter) {
 }
 
 void run_scaling(const Settings& settings, Report& report) {
-  Table table{std::string("Scaling: A (+) B against input size") + (settings.full_scaling ? "" : " (quick; --scaling for the full range)"),
-              "scaling.csv",
-              {"series", "parameter", "input facets", "output facets", "1 thread (ms)", "all threads (ms)"},
-              {},
-              {}};
+  Table table{
+      std::string("Scaling: A (+) B against input size") +
+          (settings.full_scaling ? "" : " (quick; --scaling for the full range)"),
+      "scaling.csv",
+      {"series", "parameter", "input facets", "output facets", "1 thread (ms)", "all threads (ms)"},
+      {},
+      {}};
   Settings few = settings;  // large cases: no more repetitions than needed
   few.max_reps = 5;
   std::vector<std::string> slopes;
@@ -547,9 +565,11 @@ void run_scaling(const Settings& settings, Report& report) {
   // Peak memory of the largest case of the series with the most input facets.
   std::size_t largest = 0;
   for (const auto& row : table.rows)
-    if (std::stoul(row[2]) > largest) largest = std::stoul(row[2]), last_series = row[0], last_parameter = std::stoi(row[1]);
-  table.notes.push_back("- peak memory of the largest case (" + last_series + ", " + std::to_string(last_parameter) +
-                        ", all threads, fresh process): " + peak_memory(last_series, last_parameter));
+    if (std::stoul(row[2]) > largest)
+      largest = std::stoul(row[2]), last_series = row[0], last_parameter = std::stoi(row[1]);
+  table.notes.push_back(
+      "- peak memory of the largest case (" + last_series + ", " + std::to_string(last_parameter) +
+      ", all threads, fresh process): " + peak_memory(last_series, last_parameter));
   report.table(table);
 }
 
@@ -574,8 +594,8 @@ std::string load_average() {
 std::string machine() {
   std::ostringstream out;
   out << "Machine: " << cpu_model() << ", " << std::thread::hardware_concurrency()
-      << " hardware threads (nproc " << sysconf(_SC_NPROCESSORS_ONLN)
-      << "); load average at start " << load_average() << "\n\n";
+      << " hardware threads (nproc " << sysconf(_SC_NPROCESSORS_ONLN) << "); load average at start "
+      << load_average() << "\n\n";
   return out.str();
 }
 
@@ -583,7 +603,8 @@ void usage(std::ostream& out) {
   out << "usage: morph-bench [--table1] [--morphology] [--scaling] [--all]\n"
          "                   [--csv DIR] [--markdown FILE] [--samples DIR] [--budget SECONDS]\n"
          "                   [--filter TEXT]\n"
-         "       morph-bench [--samples DIR] [--op OP] --loop A.off B.off|rotated SECONDS [THREADS]\n"
+         "       morph-bench [--samples DIR] [--op OP] --loop A.off B.off|rotated SECONDS "
+         "[THREADS]\n"
          "  no selection: Table 1, morphology and a quick scaling run\n";
 }
 
@@ -593,31 +614,43 @@ int main(int argc, char** argv) {
   try {
     Settings settings;
     const std::vector<std::string> args(argv + 1, argv + argc);
-    if (args.size() == 3 && args[0] == "--peak-case") return run_peak_case(args[1], std::stoi(args[2]));
+    if (args.size() == 3 && args[0] == "--peak-case")
+      return run_peak_case(args[1], std::stoi(args[2]));
     for (std::size_t i = 0; i < args.size(); ++i) {
       const std::string& arg = args[i];
       auto value = [&]() -> std::string {
         if (i + 1 >= args.size()) throw std::runtime_error(arg + " needs a value");
         return args[++i];
       };
-      if (arg == "--table1") settings.table1 = true;
-      else if (arg == "--morphology") settings.morphology = true;
-      else if (arg == "--scaling") settings.scaling = settings.full_scaling = true;
-      else if (arg == "--all") settings.table1 = settings.morphology = settings.scaling = settings.full_scaling = true;
-      else if (arg == "--csv") settings.csv_dir = value();
-      else if (arg == "--markdown") settings.markdown = value();
-      else if (arg == "--samples") settings.samples = value();
-      else if (arg == "--budget") settings.budget_seconds = std::stod(value());
-      else if (arg == "--filter") settings.filter = value();
-      else if (arg == "--op") settings.loop_op = value();
+      if (arg == "--table1")
+        settings.table1 = true;
+      else if (arg == "--morphology")
+        settings.morphology = true;
+      else if (arg == "--scaling")
+        settings.scaling = settings.full_scaling = true;
+      else if (arg == "--all")
+        settings.table1 = settings.morphology = settings.scaling = settings.full_scaling = true;
+      else if (arg == "--csv")
+        settings.csv_dir = value();
+      else if (arg == "--markdown")
+        settings.markdown = value();
+      else if (arg == "--samples")
+        settings.samples = value();
+      else if (arg == "--budget")
+        settings.budget_seconds = std::stod(value());
+      else if (arg == "--filter")
+        settings.filter = value();
+      else if (arg == "--op")
+        settings.loop_op = value();
       else if (arg == "--loop") {
         const std::string a = value(), b = value();
         const double seconds = std::stod(value());
         const int threads = i + 1 < args.size() && args[i + 1][0] != '-' ? std::stoi(value()) : 1;
         return run_loop(settings, a, b, seconds, threads);
-      }
-      else if (arg == "--help" || arg == "-h") return usage(std::cout), 0;
-      else throw std::runtime_error("unknown option " + arg);
+      } else if (arg == "--help" || arg == "-h")
+        return usage(std::cout), 0;
+      else
+        throw std::runtime_error("unknown option " + arg);
     }
     if (!settings.table1 && !settings.morphology && !settings.scaling)
       settings.table1 = settings.morphology = settings.scaling = true;

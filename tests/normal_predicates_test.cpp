@@ -2,12 +2,9 @@
 // the FIMS kernel: the double filter and the double-double stage must give the sign of
 // the exact evaluation, above all on the nearly degenerate triples that pairs of fine
 // spheres are full of (nearly parallel facets, mirror-symmetric facets).
-#include "../libmorph/src/polytope.h"
-
+#include <CGAL/Mpzf.h>
 #include <doctest/doctest.h>
 #include <morph/io.h>
-
-#include <CGAL/Mpzf.h>
 
 #include <algorithm>
 #include <cmath>
@@ -15,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "../libmorph/src/polytope.h"
 #include "support/polytopes.h"
 
 namespace {
@@ -46,12 +44,14 @@ void check_near_triples(const Polytope& A, const Polytope& B, int near, Tally& t
         CHECK(morph::detail::orient_normals(a, b, c) == exact);
         CHECK(morph::detail::orient_normals(b, a, c) == -exact);
         CHECK(morph::detail::orient_normals(c, b, a) == -exact);
-        const int exact_cross = CGAL::sign(morph::detail::cross_dot(a.exact(), b.exact(), a.exact(), c.exact()));
+        const int exact_cross =
+            CGAL::sign(morph::detail::cross_dot(a.exact(), b.exact(), a.exact(), c.exact()));
         CHECK(morph::detail::cross_dot_normals(a, b, a, c) == exact_cross);
         ++tally.triples;
         tally.zero += exact == 0;
         const auto &p = a.unit(), &q = b.unit(), &r = c.unit();
-        const double d = p.x * (q.y * r.z - q.z * r.y) + p.y * (q.z * r.x - q.x * r.z) + p.z * (q.x * r.y - q.y * r.x);
+        const double d = p.x * (q.y * r.z - q.z * r.y) + p.y * (q.z * r.x - q.x * r.z) +
+                         p.z * (q.x * r.y - q.y * r.x);
         tally.tiny += exact != 0 && std::abs(d) < 1e-13;
       }
   }
@@ -66,11 +66,14 @@ std::vector<double> small_rotation(double angle) {
           t * x * z - s * y, t * y * z + s * x, t * z * z + c};
 }
 
-Mesh sample(const std::string& name) { return morph::read_mesh(std::string(MORPH_SAMPLES_DIR) + "/" + name); }
+Mesh sample(const std::string& name) {
+  return morph::read_mesh(std::string(MORPH_SAMPLES_DIR) + "/" + name);
+}
 
 }  // namespace
 
-TEST_CASE("normal predicates: the filters agree with exact evaluation on nearly degenerate triples") {
+TEST_CASE(
+    "normal predicates: the filters agree with exact evaluation on nearly degenerate triples") {
   const Mesh ico320 = sample("icosphere_320.off"), ico1280 = sample("icosphere_1280.off");
   struct Pair {
     std::string what;
@@ -78,10 +81,12 @@ TEST_CASE("normal predicates: the filters agree with exact evaluation on nearly 
     bool degenerate = false;  // known to hold exactly coplanar and nearly coplanar triples
   };
   const std::vector<Pair> pairs = {
-      {"icosphere 320 and 1280 (nearly parallel and mirror-symmetric facets)", ico320, ico1280, true},
+      {"icosphere 320 and 1280 (nearly parallel and mirror-symmetric facets)", ico320, ico1280,
+       true},
       {"icosphere 1280 and a copy turned by 1e-12", ico1280,
        morph::test::transformed(ico1280, small_rotation(1e-12))},
-      {"tiny and huge copies", morph::test::scaled(ico320, 1e-60), morph::test::scaled(ico1280, 1e60)},
+      {"tiny and huge copies", morph::test::scaled(ico320, 1e-60),
+       morph::test::scaled(ico1280, 1e60)},
       {"integer polytopes", morph::test::random_integer_polytope(60, 3, 4),
        morph::test::random_integer_polytope(60, 4, 4)},
   };
@@ -91,8 +96,8 @@ TEST_CASE("normal predicates: the filters agree with exact evaluation on nearly 
     const Polytope B = morph::detail::make_operand(pair.b, "B");
     Tally tally;
     check_near_triples(A, B, 6, tally);
-    MESSAGE(pair.what << ": " << tally.triples << " triples, " << tally.zero << " exactly coplanar, " << tally.tiny
-                      << " nonzero below the double filter");
+    MESSAGE(pair.what << ": " << tally.triples << " triples, " << tally.zero
+                      << " exactly coplanar, " << tally.tiny << " nonzero below the double filter");
     CHECK(tally.triples > 0);
     if (pair.degenerate) {
       CHECK(tally.zero > 0);

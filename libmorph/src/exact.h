@@ -78,9 +78,13 @@ inline int interval_sign(const Interval& v) {
   return 2;
 }
 
-inline V3<Interval> to_interval(const V3<double>& p) { return {Interval(p.x), Interval(p.y), Interval(p.z)}; }
+inline V3<Interval> to_interval(const V3<double>& p) {
+  return {Interval(p.x), Interval(p.y), Interval(p.z)};
+}
 inline V3<Exact> to_exact(const V3<double>& p) { return {Exact(p.x), Exact(p.y), Exact(p.z)}; }
-inline V3<ExactN> to_exact_n(const V3<double>& p) { return {ExactN(p.x), ExactN(p.y), ExactN(p.z)}; }
+inline V3<ExactN> to_exact_n(const V3<double>& p) {
+  return {ExactN(p.x), ExactN(p.y), ExactN(p.z)};
+}
 inline V3<Exact> to_rational(const V3<ExactN>& p) { return {Exact(p.x), Exact(p.y), Exact(p.z)}; }
 inline V3<Interval> to_interval(const V3<Exact>& p) {
   return {Interval(CGAL::to_interval(p.x)), Interval(CGAL::to_interval(p.y)),

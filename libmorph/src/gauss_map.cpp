@@ -22,7 +22,8 @@ int region_test(const Polytope& P, int v, const NormalRef& p, int zeros[2], int&
   const int b = P.fan_begin[v], n = P.fan_begin[v + 1] - b;
   nzeros = 0;
   for (int i = 0; i < n; ++i) {
-    const int s = orient(NormalRef{&P, P.fan_face[b + i]}, NormalRef{&P, P.fan_face[b + (i + 1 == n ? 0 : i + 1)]}, p);
+    const int s = orient(NormalRef{&P, P.fan_face[b + i]},
+                         NormalRef{&P, P.fan_face[b + (i + 1 == n ? 0 : i + 1)]}, p);
     if (s < 0) return i;
     if (s == 0) {
       if (nzeros == 2) throw error("internal error: a direction lies on three arcs of one region");
@@ -51,7 +52,9 @@ Location locate(const Polytope& P, const NormalRef& p, int hint) {
   int v = hint;
   {
     const UnitNormal& d = p.unit();
-    auto support = [&](int w) { return d.x * P.points[w].x + d.y * P.points[w].y + d.z * P.points[w].z; };
+    auto support = [&](int w) {
+      return d.x * P.points[w].x + d.y * P.points[w].y + d.z * P.points[w].z;
+    };
     double best = support(v);
     for (bool moved = true; moved;) {
       moved = false;
@@ -106,8 +109,8 @@ std::vector<Location> locate_all(const Polytope& from, const Polytope& in) {
   return loc;
 }
 
-ArcContact arc_contact(const NormalRef& n1, const NormalRef& n2, const NormalRef& m1, const NormalRef& m2, int s1,
-                       int s2) {
+ArcContact arc_contact(const NormalRef& n1, const NormalRef& n2, const NormalRef& m1,
+                       const NormalRef& m2, int s1, int s2) {
   ArcContact c;
   if (s1 == 0 && s2 == 0) {  // on one great circle: touching iff they overlap
     c.touches = between(n1, m1, n2) || between(n1, m2, n2) || between(m1, n1, m2);
@@ -151,8 +154,9 @@ void arcs_around(const Polytope& P, const Location& where, std::vector<Arc>& out
   }
 }
 
-void overlay_regions(const NormalRef& p, const std::vector<Arc>& x_arcs, const std::vector<Arc>& y_arcs,
-                     int y_region, std::vector<std::pair<int, int>>& out) {
+void overlay_regions(const NormalRef& p, const std::vector<Arc>& x_arcs,
+                     const std::vector<Arc>& y_arcs, int y_region,
+                     std::vector<std::pair<int, int>>& out) {
   const int nx = static_cast<int>(x_arcs.size()), ny = static_cast<int>(y_arcs.size());
   if (ny == 0) {
     for (int i = 0; i < nx; ++i) out.emplace_back(x_arcs[i].after, y_region);
@@ -186,8 +190,10 @@ void overlay_regions(const NormalRef& p, const std::vector<Arc>& x_arcs, const s
   int i = 0, j = 0;
   while (i < nx || j < ny) {
     int c;
-    if (i == nx) c = 1;
-    else if (j == ny) c = -1;
+    if (i == nx)
+      c = 1;
+    else if (j == ny)
+      c = -1;
     else {
       const int jj = (start + j) % ny;
       c = compare(x_arcs[i].to, hx[i], y_arcs[jj].to, hy[jj]);

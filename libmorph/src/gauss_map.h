@@ -15,7 +15,9 @@ struct Location {
 };
 
 /// Sign of det(a, b, c) for three normals.
-inline int orient(const NormalRef& a, const NormalRef& b, const NormalRef& c) { return orient_normals(a, b, c); }
+inline int orient(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
+  return orient_normals(a, b, c);
+}
 
 /// Locates the direction `p` in P's Gauss map: the vertex whose region contains it in
 /// its interior (the contributing vertex), the edge whose arc contains it, or the facet
@@ -39,8 +41,8 @@ struct ArcContact {
 };
 /// s1 and s2 are orient(n1, n2, m1) and orient(n1, n2, m2), which a caller testing many
 /// arcs against one computes once per normal.
-ArcContact arc_contact(const NormalRef& n1, const NormalRef& n2, const NormalRef& m1, const NormalRef& m2, int s1,
-                       int s2);
+ArcContact arc_contact(const NormalRef& n1, const NormalRef& n2, const NormalRef& m1,
+                       const NormalRef& m2, int s1, int s2);
 
 /// An arc of a Gauss map leaving a point, toward the normal `to`, followed
 /// counter-clockwise by the region of vertex `after`.
@@ -57,7 +59,8 @@ void arcs_around(const Polytope& P, const Location& where, std::vector<Arc>& out
 /// counter-clockwise) and y_arcs (counter-clockwise, possibly empty, in which case the
 /// point lies inside the region y_region). Appends (x vertex, y vertex) pairs,
 /// counter-clockwise, one per distinct arc direction.
-void overlay_regions(const NormalRef& p, const std::vector<Arc>& x_arcs, const std::vector<Arc>& y_arcs,
-                     int y_region, std::vector<std::pair<int, int>>& out);
+void overlay_regions(const NormalRef& p, const std::vector<Arc>& x_arcs,
+                     const std::vector<Arc>& y_arcs, int y_region,
+                     std::vector<std::pair<int, int>>& out);
 
 }  // namespace morph::detail

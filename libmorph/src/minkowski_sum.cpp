@@ -1,9 +1,6 @@
 // The FIMS kernel: translated, corner and edge facets of A (+) B from the overlay of
 // the two Gauss maps, every decision exact (see gauss_map.h and docs/algorithm.md).
-#include "fims.h"
-
 #include <morph/error.h>
-
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_sort.h>
 
@@ -11,6 +8,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "fims.h"
 #include "gauss_map.h"
 #include "parallel.h"
 
@@ -38,7 +36,7 @@ struct FacetBuffer {
   std::vector<std::uint64_t> corners;
   std::vector<FacetOrigin> origins;
   std::vector<std::pair<int, int>> pairs;  // scratch
-  std::vector<Arc> x_arcs, y_arcs;        // scratch
+  std::vector<Arc> x_arcs, y_arcs;         // scratch
 
   void add(const FacetOrigin& origin) {
     for (const auto& [i, j] : pairs) corners.push_back(pair_key(i, j));
@@ -71,7 +69,8 @@ void facet_at_normal(const Polytope& X, int f, const Polytope& Y, const Location
     for (auto& c : out.pairs) std::swap(c.first, c.second);
   const Element ex{Element::Kind::facet, X.face_source[f]};
   const Element ey = element_of(Y, loc);
-  out.add(x_is_a ? FacetOrigin{FacetKind::translated, ex, ey} : FacetOrigin{FacetKind::corner, ey, ex});
+  out.add(x_is_a ? FacetOrigin{FacetKind::translated, ex, ey}
+                 : FacetOrigin{FacetKind::corner, ey, ex});
 }
 
 /// Per-thread marks for the walks of edge_facets, over B's elements.
@@ -80,7 +79,9 @@ struct WalkScratch {
   std::vector<signed char> face_side;  // orient(n1, n2, N_g), valid when face_stamp[g] is current
   std::vector<int> queue;
   explicit WalkScratch(const Polytope& B)
-      : region_stamp(B.num_vertices(), 0), edge_stamp(B.num_edges(), 0), face_stamp(B.num_faces(), 0),
+      : region_stamp(B.num_vertices(), 0),
+        edge_stamp(B.num_edges(), 0),
+        face_stamp(B.num_faces(), 0),
         face_side(B.num_faces(), 0) {}
 };
 
@@ -129,8 +130,8 @@ void edge_facets(const Polytope& A, int a, const Polytope& B, const Location& st
       if (w.edge_stamp[e] == stamp) continue;
       w.edge_stamp[e] = stamp;
       const auto& eb = B.edges[e];
-      const ArcContact c =
-          arc_contact(n1, n2, NormalRef{&B, eb.left}, NormalRef{&B, eb.right}, side(eb.left), side(eb.right));
+      const ArcContact c = arc_contact(n1, n2, NormalRef{&B, eb.left}, NormalRef{&B, eb.right},
+                                       side(eb.left), side(eb.right));
       if (c.crosses) crossings.emplace_back(e, c.side);
       if (c.touches) visit(B.fan_vertex[s]);
     }
@@ -145,8 +146,9 @@ void edge_facets(const Polytope& A, int a, const Polytope& B, const Location& st
     const auto& q = quad[side_of_b > 0];
     out.corners.insert(out.corners.end(), q, q + 4);
     out.sizes.push_back(4);
-    out.origins.push_back(
-        {FacetKind::edge, {Element::Kind::edge, A.edge_source[a]}, {Element::Kind::edge, B.edge_source[e]}});
+    out.origins.push_back({FacetKind::edge,
+                           {Element::Kind::edge, A.edge_source[a]},
+                           {Element::Kind::edge, B.edge_source[e]}});
   }
 }
 
@@ -186,7 +188,9 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
     for (int a = begin; a < end; ++a) {
       const auto& l = loc_a[A.edges[a].left];
       const auto& r = loc_a[A.edges[a].right];
-      if (l.kind == Location::Kind::vertex && r.kind == Location::Kind::vertex && l.index == r.index) continue;
+      if (l.kind == Location::Kind::vertex && r.kind == Location::Kind::vertex &&
+          l.index == r.index)
+        continue;
       edge_facets(A, a, B, l, w, out);
     }
   });
@@ -201,14 +205,16 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
 namespace {
 
 /// The distinct vertex pairs of the facets, sorted, and each corner's index among them.
-void index_vertices(const SumFacets& facets, std::vector<std::uint64_t>& pairs, std::vector<int>& corners) {
+void index_vertices(const SumFacets& facets, std::vector<std::uint64_t>& pairs,
+                    std::vector<int>& corners) {
   pairs = facets.corners;
   tbb::parallel_sort(pairs.begin(), pairs.end());
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
   corners.resize(facets.corners.size());
   parallel_chunks(static_cast<int>(corners.size()), 4096, [&](int begin, int end) {
     for (int c = begin; c < end; ++c)
-      corners[c] = static_cast<int>(std::lower_bound(pairs.begin(), pairs.end(), facets.corners[c]) - pairs.begin());
+      corners[c] = static_cast<int>(
+          std::lower_bound(pairs.begin(), pairs.end(), facets.corners[c]) - pairs.begin());
   });
 }
 
@@ -237,7 +243,8 @@ LabelledMesh sum_mesh(const Polytope& A, const Polytope& B, const SumFacets& fac
   LabelledMesh out;
   out.mesh = clean_mesh(points, facets.face_begin, corners, &source);
   // A face with no source (a triangle of the hull fallback that no facet owns) has no origin.
-  for (int f : source) out.origins.push_back(f >= 0 ? facets.origins[f] : FacetOrigin{FacetKind::edge, {}, {}});
+  for (int f : source)
+    out.origins.push_back(f >= 0 ? facets.origins[f] : FacetOrigin{FacetKind::edge, {}, {}});
   return out;
 }
 
@@ -249,7 +256,8 @@ Polytope sum_polytope(const Polytope& A, const Polytope& B, const SumFacets& fac
   std::vector<V3<Exact>> exact(pairs.size());
   for (std::size_t v = 0; v < pairs.size(); ++v) {
     exact[v] = A.exact_point(pair_first(pairs[v])) + B.exact_point(pair_second(pairs[v]));
-    points[v] = {round_to_nearest(exact[v].x), round_to_nearest(exact[v].y), round_to_nearest(exact[v].z)};
+    points[v] = {round_to_nearest(exact[v].x), round_to_nearest(exact[v].y),
+                 round_to_nearest(exact[v].z)};
   }
   if (!A.exact_points.empty() || !B.exact_points.empty())
     throw error("internal error: an exact sum needs operands with double points");
@@ -257,7 +265,8 @@ Polytope sum_polytope(const Polytope& A, const Polytope& B, const SumFacets& fac
   std::vector<V3<ExactN>> normals(facets.num_faces());
   std::vector<V3<ExactN>> cycle;
   for (int f = 0; f < facets.num_faces(); ++f) {
-    faces[f].assign(corners.begin() + facets.face_begin[f], corners.begin() + facets.face_begin[f + 1]);
+    faces[f].assign(corners.begin() + facets.face_begin[f],
+                    corners.begin() + facets.face_begin[f + 1]);
     cycle.clear();
     for (int c = facets.face_begin[f]; c < facets.face_begin[f + 1]; ++c)
       cycle.push_back(to_exact_n(A.points[pair_first(facets.corners[c])]) +

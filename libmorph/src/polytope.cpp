@@ -2,7 +2,6 @@
 
 #include <morph/error.h>
 #include <morph/validate.h>
-
 #include <mpfr.h>
 
 #include <algorithm>
@@ -53,7 +52,7 @@ inline DD quick_two_sum(double a, double b) {
   const double s = a + b;
   return {s, b - (s - a)};
 }
-inline DD split(double a) {  // Veltkamp: a = hi + lo with 26-bit halves (|a| < 2^995)
+inline DD split(double a) {          // Veltkamp: a = hi + lo with 26-bit halves (|a| < 2^995)
   const double c = 134217729.0 * a;  // 2^27 + 1
   const double hi = c - (c - a);
   return {hi, a - hi};
@@ -156,8 +155,8 @@ PreciseNormal precise_newell(const std::vector<V3<double>>& points, const int* c
 
 /// Upper bound on the Euclidean length of a precise normal (the sum of |components|).
 double length_bound(const PreciseNormal& n) {
-  return (std::abs(n.hi[0]) + std::abs(n.hi[1]) + std::abs(n.hi[2])) * (1 + 1e-15) + n.error[0] + n.error[1] +
-         n.error[2];
+  return (std::abs(n.hi[0]) + std::abs(n.hi[1]) + std::abs(n.hi[2])) * (1 + 1e-15) + n.error[0] +
+         n.error[1] + n.error[2];
 }
 
 /// Upper bound on the Euclidean length of a precise normal's error vector.
@@ -198,12 +197,14 @@ void Polytope::compute_normals() {
   unit_normals.resize(nf);
   for (int f = 0; f < nf; ++f) {
     const V3<Interval>& n = normals[f];
-    const V3<double> m{0.5 * (n.x.inf() + n.x.sup()), 0.5 * (n.y.inf() + n.y.sup()), 0.5 * (n.z.inf() + n.z.sup())};
+    const V3<double> m{0.5 * (n.x.inf() + n.x.sup()), 0.5 * (n.y.inf() + n.y.sup()),
+                       0.5 * (n.z.inf() + n.z.sup())};
     const V3<double> r{n.x.sup() - n.x.inf(), n.y.sup() - n.y.inf(), n.z.sup() - n.z.inf()};
     const double length = std::sqrt(dot(m, m));
     const double radius = 0.5 * std::sqrt(dot(r, r));
     double error = 2 * radius / length * (1 + 1e-10) + 4e-15;
-    if (!(length > 0) || !std::isfinite(error) || error > 1) error = std::numeric_limits<double>::infinity();
+    if (!(length > 0) || !std::isfinite(error) || error > 1)
+      error = std::numeric_limits<double>::infinity();
     unit_normals[f] = length > 0 ? UnitNormal{m.x / length, m.y / length, m.z / length, error}
                                  : UnitNormal{0, 0, 0, error};
   }
@@ -229,15 +230,17 @@ int orient_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef
       double permanent = 0;
       for (int i = 0; i < 3; ++i) {
         const int j = (i + 1) % 3, l = (i + 2) % 3;
-        permanent += std::abs(p.hi[i]) * (std::abs(q.hi[j] * r.hi[l]) + std::abs(q.hi[l] * r.hi[j]));
+        permanent +=
+            std::abs(p.hi[i]) * (std::abs(q.hi[j] * r.hi[l]) + std::abs(q.hi[l] * r.hi[j]));
       }
       // The inputs: det moves by at most |da| |b| |c| + |a'| |db| |c| + |a'| |b'| |dc|, with
       // x' = x + dx.
       const double la = length_bound(p), lb = length_bound(q), lc = length_bound(r);
       const double da = error_bound(p), db = error_bound(q), dc = error_bound(r);
-      const double bound =
-          (da * lb * lc + (la + da) * db * lc + (la + da) * (lb + db) * dc + 64 * kU2 * permanent * 1.1) * 1.01 +
-          0x1p-1000;
+      const double bound = (da * lb * lc + (la + da) * db * lc + (la + da) * (lb + db) * dc +
+                            64 * kU2 * permanent * 1.1) *
+                               1.01 +
+                           0x1p-1000;
       if (value.hi > bound) return 1;
       if (value.hi < -bound) return -1;
     }
@@ -245,16 +248,17 @@ int orient_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef
   return CGAL::sign(det(a.exact(), b.exact(), c.exact()));
 }
 
-int cross_dot_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef& c, const NormalRef& d) {
+int cross_dot_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef& c,
+                            const NormalRef& d) {
   return CGAL::sign(cross_dot(a.exact(), b.exact(), c.exact(), d.exact()));
 }
 
 namespace {
 
 std::uint64_t key(int u, int w) {
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(u)) << 32) | static_cast<std::uint32_t>(w);
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(u)) << 32) |
+         static_cast<std::uint32_t>(w);
 }
-
 
 struct UnionFind {
   std::vector<int> parent;
@@ -294,7 +298,8 @@ void build_connectivity(Polytope& p, const std::vector<std::vector<int>>& faces,
       const int u = p.corner_vertex[c];
       const int w = p.corner(f, (k + 1) % p.degree(f));
       if (!corner_of.emplace(key(u, w), c).second)
-        fail(name, "edge " + std::to_string(u) + "-" + std::to_string(w) + " is used twice in one direction");
+        fail(name, "edge " + std::to_string(u) + "-" + std::to_string(w) +
+                       " is used twice in one direction");
     }
   }
   auto next_corner = [&](int c) {
@@ -353,8 +358,8 @@ void build_connectivity(Polytope& p, const std::vector<std::vector<int>>& faces,
 
 /// Sign of det(N_left, N_right, to - from): positive when the edge is strictly convex.
 int edge_convexity(const Polytope& p, const Polytope::Edge& e) {
-  const int s = interval_sign(
-      det(p.normals[e.left], p.normals[e.right], p.interval_point(e.to) - p.interval_point(e.from)));
+  const int s = interval_sign(det(p.normals[e.left], p.normals[e.right],
+                                  p.interval_point(e.to) - p.interval_point(e.from)));
   if (s != 2) return s;
   if (p.exact_points.empty())
     return CGAL::sign(det(p.exact_normal(e.left), p.exact_normal(e.right),
@@ -372,7 +377,8 @@ void check_gauss_map(const Polytope& p, const char* name) {
     if (n < 3)
       fail(name, "vertex " + std::to_string(p.vertex_source[v]) + " has fewer than three facets");
     for (int i = 0; i < n; ++i) {
-      const int s = orient_normals(NormalRef{&p, p.fan_face[b + i]}, NormalRef{&p, p.fan_face[b + (i + 1) % n]},
+      const int s = orient_normals(NormalRef{&p, p.fan_face[b + i]},
+                                   NormalRef{&p, p.fan_face[b + (i + 1) % n]},
                                    NormalRef{&p, p.fan_face[b + (i + 2) % n]});
       if (s <= 0)
         fail(name, "the facets around vertex " + std::to_string(p.vertex_source[v]) +
@@ -504,8 +510,8 @@ bool has_deleted_elements(const Mesh& mesh) {
 }  // namespace
 
 Polytope make_polytope(std::vector<V3<double>> points, std::vector<V3<Exact>> exact_points,
-                       const std::vector<std::vector<int>>& input_faces, std::vector<V3<ExactN>> given_normals,
-                       const char* name) {
+                       const std::vector<std::vector<int>>& input_faces,
+                       std::vector<V3<ExactN>> given_normals, const char* name) {
   if (!exact_points.empty() && given_normals.size() != input_faces.size())
     throw error("internal error: a polytope with exact points needs one exact normal per facet");
   std::vector<std::vector<int>> faces = input_faces;
@@ -518,7 +524,8 @@ Polytope make_polytope(std::vector<V3<double>> points, std::vector<V3<Exact>> ex
     build_connectivity(p, faces, name);
     if (!given_normals.empty()) {
       p.given_normals.resize(faces.size());
-      for (std::size_t f = 0; f < faces.size(); ++f) p.given_normals[f] = given_normals[face_source[f]];
+      for (std::size_t f = 0; f < faces.size(); ++f)
+        p.given_normals[f] = given_normals[face_source[f]];
     }
     p.compute_normals();
     UnionFind groups(p.num_faces());
@@ -541,13 +548,16 @@ Polytope make_polytope(std::vector<V3<double>> points, std::vector<V3<Exact>> ex
     const int nf = p.num_faces();
     std::vector<int> group_of(nf);
     for (int f = 0; f < nf; ++f) group_of[f] = groups.find(f);
-    std::unordered_map<std::uint64_t, int> next_of;  // (group, vertex) -> next vertex on the boundary
+    std::unordered_map<std::uint64_t, int>
+        next_of;  // (group, vertex) -> next vertex on the boundary
     std::vector<int> start_of(nf, -1), boundary_count(nf, 0);
     for (const auto& e : p.edges) {
       const int gl = group_of[e.left], gr = group_of[e.right];
       if (gl == gr) continue;
-      if (!next_of.emplace(key(gl, e.from), e.to).second || !next_of.emplace(key(gr, e.to), e.from).second)
-        fail(name, "merged coplanar facets around vertex " + std::to_string(e.from) + " do not form a disc");
+      if (!next_of.emplace(key(gl, e.from), e.to).second ||
+          !next_of.emplace(key(gr, e.to), e.from).second)
+        fail(name, "merged coplanar facets around vertex " + std::to_string(e.from) +
+                       " do not form a disc");
       start_of[gl] = e.from;
       start_of[gr] = e.to;
       ++boundary_count[gl];
@@ -562,8 +572,10 @@ Polytope make_polytope(std::vector<V3<double>> points, std::vector<V3<Exact>> ex
       for (int s = p.fan_begin[v]; s < p.fan_begin[v + 1]; ++s) {
         const int g = group_of[p.fan_face[s]];
         if (g == first || g == second) continue;
-        if (first < 0) first = g;
-        else if (second < 0) second = g;
+        if (first < 0)
+          first = g;
+        else if (second < 0)
+          second = g;
         ++distinct;
         if (distinct >= 3) break;
       }
@@ -584,8 +596,10 @@ Polytope make_polytope(std::vector<V3<double>> points, std::vector<V3<Exact>> ex
           fail(name, "merged facet " + std::to_string(face_source[f]) + " has a broken boundary");
       } while (v != start_of[f]);
       if (steps != boundary_count[f])
-        fail(name, "coplanar facets around facet " + std::to_string(face_source[f]) + " do not form a disc");
-      if (cyc.size() < 3) fail(name, "facet " + std::to_string(face_source[f]) + " degenerates when merged");
+        fail(name, "coplanar facets around facet " + std::to_string(face_source[f]) +
+                       " do not form a disc");
+      if (cyc.size() < 3)
+        fail(name, "facet " + std::to_string(face_source[f]) + " degenerates when merged");
       merged_faces.push_back(std::move(cyc));
       merged_source.push_back(face_source[f]);
     }
@@ -615,7 +629,8 @@ Polytope make_polytope(std::vector<V3<double>> points, std::vector<V3<Exact>> ex
     p.vertex_source = std::move(vsrc);
     build_connectivity(p, faces, name);
     if (!given_normals.empty())
-      for (std::size_t f = 0; f < faces.size(); ++f) p.given_normals[f] = given_normals[face_source[f]];
+      for (std::size_t f = 0; f < faces.size(); ++f)
+        p.given_normals[f] = given_normals[face_source[f]];
     p.compute_normals();
   } else {
     p.vertex_source.resize(used);
@@ -711,7 +726,8 @@ Mesh to_mesh(const Polytope& p) {
     face.clear();
     for (int k = 0; k < p.degree(f); ++k) face.push_back(vh[p.corner(f, k)]);
     if (!mesh.add_face(face).is_valid())
-      throw error("internal error: facet " + std::to_string(f) + " of a result could not be added to the mesh");
+      throw error("internal error: facet " + std::to_string(f) +
+                  " of a result could not be added to the mesh");
   }
   return mesh;
 }

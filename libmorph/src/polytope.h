@@ -46,7 +46,7 @@ struct PreciseNormal {
 
 struct Polytope {
   struct Edge {
-    int from = -1, to = -1;    // vertices; `left` contains the directed edge from -> to
+    int from = -1, to = -1;     // vertices; `left` contains the directed edge from -> to
     int left = -1, right = -1;  // facets
   };
 
@@ -101,7 +101,7 @@ struct Polytope {
   /// normals; call after the facets are final.
   void compute_normals();
 
- /// Newell's normal of facet f in double-double arithmetic, scaled by a power of two,
+  /// Newell's normal of facet f in double-double arithmetic, scaled by a power of two,
   /// with an error bound: the second stage of the normal predicates. Computed on first
   /// use and kept, as exact_normal.
   const PreciseNormal& precise_normal(int f) const;
@@ -155,12 +155,14 @@ struct NormalRef {
 inline constexpr double kUnitPredicateRounding = 2e-14;
 
 int orient_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef& c);
-int cross_dot_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef& c, const NormalRef& d);
+int cross_dot_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef& c,
+                            const NormalRef& d);
 
 /// Sign of det(N_a, N_b, N_c).
 inline int orient_normals(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
   const UnitNormal &p = a.unit(), &q = b.unit(), &r = c.unit();
-  const double d = p.x * (q.y * r.z - q.z * r.y) + p.y * (q.z * r.x - q.x * r.z) + p.z * (q.x * r.y - q.y * r.x);
+  const double d =
+      p.x * (q.y * r.z - q.z * r.y) + p.y * (q.z * r.x - q.x * r.z) + p.z * (q.x * r.y - q.y * r.x);
   // det is 1-Lipschitz in each unit argument.
   const double bound = p.error + q.error + r.error + kUnitPredicateRounding;
   if (d > bound) return 1;
@@ -169,9 +171,12 @@ inline int orient_normals(const NormalRef& a, const NormalRef& b, const NormalRe
 }
 
 /// Sign of (N_a x N_b) . (N_c x N_d) = (N_a.N_c)(N_b.N_d) - (N_a.N_d)(N_b.N_c).
-inline int cross_dot_normals(const NormalRef& a, const NormalRef& b, const NormalRef& c, const NormalRef& d) {
+inline int cross_dot_normals(const NormalRef& a, const NormalRef& b, const NormalRef& c,
+                             const NormalRef& d) {
   const UnitNormal &p = a.unit(), &q = b.unit(), &r = c.unit(), &s = d.unit();
-  auto dot3 = [](const UnitNormal& u, const UnitNormal& v) { return u.x * v.x + u.y * v.y + u.z * v.z; };
+  auto dot3 = [](const UnitNormal& u, const UnitNormal& v) {
+    return u.x * v.x + u.y * v.y + u.z * v.z;
+  };
   const double value = dot3(p, r) * dot3(q, s) - dot3(p, s) * dot3(q, r);
   // 2-Lipschitz in each unit argument; the second-order term covers errors up to 1.
   const double e = p.error + q.error + r.error + s.error;
@@ -203,8 +208,8 @@ Polytope make_polytope_from_cycles(const Mesh& mesh, const char* name,
 /// `exact_points` is non-empty, and then one exact normal per facet in `given_normals`),
 /// canonicalising it as make_polytope does. Vertices not used by any facet are dropped.
 Polytope make_polytope(std::vector<V3<double>> points, std::vector<V3<Exact>> exact_points,
-                       const std::vector<std::vector<int>>& faces, std::vector<V3<ExactN>> given_normals,
-                       const char* name);
+                       const std::vector<std::vector<int>>& faces,
+                       std::vector<V3<ExactN>> given_normals, const char* name);
 
 /// An operand: checks `mesh` with prepare_convex_polyhedron (throwing invalid_mesh /
 /// not_convex prefixed with `name`, flipping a fully inverted mesh) and builds its polytope.
