@@ -145,24 +145,11 @@ FaceCycles face_cycles(const MeshView& m) {
 
 // ---------------------------------------------------------------- topology
 
-// Plain union-find over vertex indices, for connectivity.
-struct DisjointSets {
-  std::vector<int> parent;
-  explicit DisjointSets(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-  int find(int x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  }
-  void unite(int a, int b) { parent[find(a)] = find(b); }
-};
-
 Finding closed_manifold(const MeshView& m) {
   long long n_vertices = 0, n_edges = 0, n_faces = 0;
   for (int f = 0; f < m.n_faces; ++f) n_faces += m.live_face(f);
   if (n_faces == 0) return fail(Verdict::invalid, "the mesh is empty (it has no faces)");
 
-  // Closed, and the components joined by the edges (used only once the vertices pass).
-  DisjointSets components(m.n_vertices);
   for (int e = 0; e < m.n_edges; ++e) {
     if (!m.live_edge(e)) continue;
     ++n_edges;
@@ -170,7 +157,6 @@ Finding closed_manifold(const MeshView& m) {
       return fail(Verdict::invalid, "edge " + std::to_string(e) + " (vertices " +
                                         vertex_pair(m, e) +
                                         ") has only one face: the mesh is not closed");
-    components.unite(m.from(2 * e), m.to(2 * e));
   }
 
   // A vertex is manifold when the faces around it form one fan: the circulator around
@@ -215,16 +201,31 @@ Finding closed_manifold(const MeshView& m) {
     }
   }
 
-  int first = -1;
-  for (int v = 0; v < m.n_vertices; ++v) {
-    if (!m.live_vertex(v)) continue;
-    if (first < 0) {
-      first = v;
-    } else if (components.find(v) != components.find(first)) {
+  // Connected: every vertex is reached from the first one through the fans, which now
+  // hold every edge.
+  int first = 0;
+  while (!m.live_vertex(first)) ++first;  // there are faces, so there are live vertices
+  std::vector<char> reached(m.n_vertices, 0);
+  std::vector<int> stack{first};
+  reached[first] = 1;
+  while (!stack.empty()) {
+    const int v = stack.back();
+    stack.pop_back();
+    const int out = m.halfedge_of_vertex(v);
+    int h = out;
+    do {
+      const int w = m.to(h);
+      if (!reached[w]) {
+        reached[w] = 1;
+        stack.push_back(w);
+      }
+      h = m.next(h ^ 1);
+    } while (h != out);
+  }
+  for (int v = first + 1; v < m.n_vertices; ++v)
+    if (m.live_vertex(v) && !reached[v])
       return fail(Verdict::invalid, "the mesh is not connected: vertex " + std::to_string(v) +
                                         " is not connected to vertex " + std::to_string(first));
-    }
-  }
 
   const long long euler = n_vertices - n_edges + n_faces;
   if (euler != 2)
