@@ -6,6 +6,7 @@
 #include <mpfr.h>
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 #include <string>
 #include <unordered_map>
@@ -173,8 +174,47 @@ void build_connectivity(Polytope& p, const std::vector<std::vector<int>>& faces,
       fail(name, "vertex " + std::to_string(v) + " is not manifold");
 }
 
+// Relative error bound of Shewchuk's orient3d evaluated in double, (7 + 56 eps) eps, with
+// eps = 2^-52 (one ulp per operation) so that it holds in any rounding mode: is_canonical
+// runs under a RoundingGuard, which rounds upward.
+constexpr double kOrient3dErrorBound = (7.0 + 56.0 * 0x1p-52) * 0x1p-52;
+// Below this permanent, products may underflow and the relative bound no longer holds.
+constexpr double kOrient3dMinPermanent = 1e-280;
+
+/// The vertex of triangle f other than u and w.
+int third_vertex(const Polytope& p, int f, int u, int w) {
+  const int* c = &p.corner_vertex[p.face_begin[f]];
+  return c[0] != u && c[0] != w ? c[0] : c[1] != u && c[1] != w ? c[1] : c[2];
+}
+
+/// edge_convexity() between two triangles of double points, decided in double when a
+/// static bound allows, else 2. With d = to - from and the far vertices a (of left) and b
+/// (of right), N_left = d x (a - from) and N_right = (b - from) x d, so that
+/// det(N_left, N_right, d) = -|d|^2 det(d, a - from, b - from): one orientation.
+int triangle_edge_convexity(const Polytope& p, const Polytope::Edge& e) {
+  const V3<double>& o = p.points[e.from];
+  const V3<double> d = p.points[e.to] - o;
+  const V3<double> a = p.points[third_vertex(p, e.left, e.from, e.to)] - o;
+  const V3<double> b = p.points[third_vertex(p, e.right, e.from, e.to)] - o;
+  const double ab_x = a.y * b.z - a.z * b.y, ab_y = a.z * b.x - a.x * b.z,
+               ab_z = a.x * b.y - a.y * b.x;
+  const double orientation = d.x * ab_x + d.y * ab_y + d.z * ab_z;
+  using std::abs;
+  const double permanent = abs(d.x) * (abs(a.y * b.z) + abs(a.z * b.y)) +
+                           abs(d.y) * (abs(a.z * b.x) + abs(a.x * b.z)) +
+                           abs(d.z) * (abs(a.x * b.y) + abs(a.y * b.x));
+  if (!(permanent >= kOrient3dMinPermanent)) return 2;  // also NaN
+  const double bound = kOrient3dErrorBound * permanent;
+  if (orientation > bound) return -1;
+  if (orientation < -bound) return 1;
+  return 2;
+}
+
 /// Sign of det(N_left, N_right, to - from): positive when the edge is strictly convex.
 int edge_convexity(const Polytope& p, const Polytope::Edge& e) {
+  if (p.exact_points.empty() && p.degree(e.left) == 3 && p.degree(e.right) == 3) {
+    if (const int s = triangle_edge_convexity(p, e); s != 2) return s;
+  }
   const int s = interval_sign(
       det(p.normals[e.left], p.normals[e.right], p.interval_point(e.to) - p.interval_point(e.from)));
   if (s != 2) return s;
