@@ -165,14 +165,12 @@ Finding closed_manifold(const MeshView& m) {
   std::vector<int> outgoing(m.n_vertices, 0);
   for (int h = 0; h < m.n_halfedges; ++h)
     if (m.live_halfedge(h)) ++outgoing[m.from(h)];
+  enum class Fan : char { unreached, queued, one, isolated, several, pinched };
   // seen[w] == v: w was already reached from v (a stamp, so the array is never cleared).
   std::vector<int> seen(m.n_vertices, -1);
-  for (int v = 0; v < m.n_vertices; ++v) {
-    if (!m.live_vertex(v)) continue;
-    ++n_vertices;
-    if (outgoing[v] == 0)
-      return fail(Verdict::invalid,
-                  "vertex " + std::to_string(v) + " is isolated (it belongs to no face)");
+  // Walks the fan of v, calling visit(w) for each neighbour w it reaches.
+  const auto walk_fan = [&](int v, const auto& visit) {
+    if (outgoing[v] == 0) return Fan::isolated;
     int reached = 0;
     bool pinched = false;
     // The outgoing halfedges around v, as the circulator walks them.
@@ -180,15 +178,45 @@ Finding closed_manifold(const MeshView& m) {
     int h = first;
     do {
       const int w = m.to(h);
+      visit(w);
       pinched = pinched || seen[w] == v;
       seen[w] = v;
       if (++reached > outgoing[v]) break;  // corrupt links
       h = m.next(h ^ 1);
     } while (h != first);
-    if (reached != outgoing[v])
+    if (reached != outgoing[v]) return Fan::several;
+    return pinched ? Fan::pinched : Fan::one;
+  };
+
+  // Each fan is walked once, in a search from the first vertex that also finds the
+  // vertices connected to it (through the fans, which hold every edge once the vertices
+  // pass); then the vertices are judged in index order, as the rule lists them.
+  int first = 0;
+  while (first < m.n_vertices && !m.live_vertex(first)) ++first;
+  std::vector<Fan> fan(m.n_vertices, Fan::unreached);
+  std::vector<int> stack;
+  const auto reach = [&](int w) {
+    if (fan[w] != Fan::unreached) return;
+    fan[w] = Fan::queued;
+    stack.push_back(w);
+  };
+  if (first < m.n_vertices) reach(first);
+  while (!stack.empty()) {
+    const int v = stack.back();
+    stack.pop_back();
+    fan[v] = walk_fan(v, reach);
+  }
+  for (int v = 0; v < m.n_vertices; ++v) {
+    if (!m.live_vertex(v)) continue;
+    ++n_vertices;
+    const Fan found = fan[v] == Fan::unreached ? walk_fan(v, [](int) {}) : fan[v];
+    if (found == Fan::isolated)
+      return fail(Verdict::invalid,
+                  "vertex " + std::to_string(v) + " is isolated (it belongs to no face)");
+    if (found == Fan::several)
       return fail(Verdict::invalid, "vertex " + std::to_string(v) +
                                         " is not manifold: its faces form more than one fan");
-    if (pinched) {
+    if (found == Fan::pinched) {
       // Name the smallest neighbour reached twice.
       std::vector<int> neighbours;
       for (auto oh : m.mesh.voh_range(Mesh::VertexHandle(v)))
@@ -200,30 +228,8 @@ Finding closed_manifold(const MeshView& m) {
                                         " are joined by two edges: the mesh is not 2-manifold");
     }
   }
-
-  // Connected: every vertex is reached from the first one through the fans, which now
-  // hold every edge.
-  int first = 0;
-  while (!m.live_vertex(first)) ++first;  // there are faces, so there are live vertices
-  std::vector<char> reached(m.n_vertices, 0);
-  std::vector<int> stack{first};
-  reached[first] = 1;
-  while (!stack.empty()) {
-    const int v = stack.back();
-    stack.pop_back();
-    const int out = m.halfedge_of_vertex(v);
-    int h = out;
-    do {
-      const int w = m.to(h);
-      if (!reached[w]) {
-        reached[w] = 1;
-        stack.push_back(w);
-      }
-      h = m.next(h ^ 1);
-    } while (h != out);
-  }
   for (int v = first + 1; v < m.n_vertices; ++v)
-    if (m.live_vertex(v) && !reached[v])
+    if (m.live_vertex(v) && fan[v] == Fan::unreached)
       return fail(Verdict::invalid, "the mesh is not connected: vertex " + std::to_string(v) +
                                         " is not connected to vertex " + std::to_string(first));
 
