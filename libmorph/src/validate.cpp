@@ -59,18 +59,27 @@ struct MeshView {
         n_edges(static_cast<int>(m.n_edges())),
         n_halfedges(static_cast<int>(m.n_halfedges())),
         n_faces(static_cast<int>(m.n_faces())),
-        vertex_status(m.has_vertex_status() ? m.property(m.vertex_status_pph()).data() : nullptr),
-        edge_status(m.has_edge_status() ? m.property(m.edge_status_pph()).data() : nullptr),
-        halfedge_status(m.has_halfedge_status() ? m.property(m.halfedge_status_pph()).data()
-                                                : nullptr),
-        face_status(m.has_face_status() ? m.property(m.face_status_pph()).data() : nullptr) {}
+        vertex_status(deleted_status(m, m.vertex_status_pph())),
+        edge_status(deleted_status(m, m.edge_status_pph())),
+        halfedge_status(deleted_status(m, m.halfedge_status_pph())),
+        face_status(deleted_status(m, m.face_status_pph())) {}
 
   const Mesh& mesh;
   const Point* points;
   int n_vertices, n_edges, n_halfedges, n_faces;
-  // Null when the mesh has no status of that kind (nothing of it can be deleted).
+  // Null when no element of that kind is deleted (or the kind has no status).
   const OpenMesh::Attributes::StatusInfo *vertex_status, *edge_status, *halfedge_status,
       *face_status;
+
+  template <class StatusHandle>
+  static const OpenMesh::Attributes::StatusInfo* deleted_status(const Mesh& m,
+                                                                StatusHandle handle) {
+    if (!handle.is_valid()) return nullptr;
+    const auto& status = m.property(handle).data_vector();
+    const bool any = std::any_of(status.begin(), status.end(),
+                                 [](const auto& s) { return s.deleted(); });
+    return any ? status.data() : nullptr;
+  }
 
   bool live_vertex(int v) const { return !vertex_status || !vertex_status[v].deleted(); }
   bool live_edge(int e) const { return !edge_status || !edge_status[e].deleted(); }
@@ -253,18 +262,10 @@ struct FacePlane {
   Point normal{0, 0, 0};  // unit length once the face is known to be non-degenerate
 };
 
-// What the geometric checks share: the extent, the face cycles and every face's plane,
-// computed once by nondegenerate().
-struct Geometry {
-  Extent extent;
-  FaceCycles cycles;
-  std::vector<FacePlane> planes;  // by face index, normals of unit length
-};
-
 FacePlane newell_plane(const Point* points, const int* corners, int n) {
   FacePlane plane;
   for (int i = 0; i < n; ++i) plane.centroid += points[corners[i]];
-  plane.centroid /= static_cast<double>(n);
+  plane.centroid *= 1.0 / n;
   for (int i = 0; i < n; ++i) {
     const Point a = points[corners[i]] - plane.centroid;
     const Point b = points[corners[i + 1 == n ? 0 : i + 1]] - plane.centroid;
@@ -272,6 +273,48 @@ FacePlane newell_plane(const Point* points, const int* corners, int n) {
   }
   return plane;
 }
+
+// Signed distance of p above a face's plane.
+double height(const FacePlane& plane, const Point& p) {
+  return OpenMesh::dot(p - plane.centroid, plane.normal);
+}
+
+// Six times the signed volume about an origin, and six times the sum of the absolute
+// volumes of the fan tetrahedra (the scale of the rounding error).
+struct FanVolumes {
+  double total = 0, absolute = 0;
+
+  // Adds the fan of a face from its last corner (the source of its halfedge).
+  void add_face(const Point* points, const int* corners, int n, const Point& origin) {
+    const Point a = points[corners[n - 1]] - origin;
+    for (int k = 0; corners[k + 1] != corners[n - 1]; ++k) {
+      const Point b = points[corners[k]] - origin;
+      const Point c = points[corners[k + 1]] - origin;
+      const double six_v = OpenMesh::dot(a, OpenMesh::cross(b, c));
+      total += six_v;
+      absolute += std::abs(six_v);
+    }
+  }
+};
+
+FanVolumes fan_volumes(const MeshView& m, const FaceCycles& cycles, const Point& origin) {
+  FanVolumes volumes;
+  for (int f = 0; f < m.n_faces; ++f)
+    if (cycles.degree(f) > 0) volumes.add_face(m.points, cycles.corners(f), cycles.degree(f), origin);
+  return volumes;
+}
+
+// What the geometric checks share, gathered in one pass over the faces by
+// nondegenerate(): the extent, the face cycles and unit planes, the fan volumes about the
+// extent's centre, and the first face that is not planar (reported only after the
+// orientation, as the rule orders them).
+struct Geometry {
+  Extent extent;
+  FaceCycles cycles;
+  std::vector<FacePlane> planes;  // by face index
+  FanVolumes volumes;
+  int non_planar_face = -1;
+};
 
 // Whether two of the n values key(0), ..., key(n - 1) are equal (quadratic: faces are
 // small; sorting would allocate).
@@ -283,9 +326,9 @@ bool has_equal_pair(int n, const Key& key) {
   return false;
 }
 
-// Fills `geometry` (extent, face cycles and unit face planes) for the later checks when
-// the mesh passes.
-Finding nondegenerate(const MeshView& m, Geometry& geometry) {
+// Fills `geometry` for the later checks when the mesh passes; planarity is judged with
+// `relative_tolerance` times the bounding-box diagonal.
+Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& geometry) {
   for (int v = 0; v < m.n_vertices; ++v) {
     if (!m.live_vertex(v)) continue;
     const Point& p = m.points[v];
@@ -295,6 +338,7 @@ Finding nondegenerate(const MeshView& m, Geometry& geometry) {
   }
   geometry.extent = bounding_box(m);
   const double diagonal = geometry.extent.diagonal;
+  const double tolerance = relative_tolerance * diagonal;
   geometry.cycles = face_cycles(m);
   geometry.planes.resize(m.n_faces);
   for (int f = 0; f < m.n_faces; ++f) {
@@ -319,43 +363,19 @@ Finding nondegenerate(const MeshView& m, Geometry& geometry) {
     const double length = plane.normal.norm();
     if (!(length > kZeroAreaRatio * diagonal * diagonal))
       return fail(Verdict::invalid, face() + " has zero area (its vertices are collinear)");
-    plane.normal /= length;
+    plane.normal *= 1.0 / length;
+    geometry.volumes.add_face(m.points, ids, n, geometry.extent.centre);
+    for (int k = 0; k < n && geometry.non_planar_face < 0; ++k)
+      if (!(std::abs(height(plane, m.points[ids[k]])) <= tolerance)) geometry.non_planar_face = f;
   }
   return {};
 }
 
-Finding nondegenerate(const MeshView& m) {
-  Geometry geometry;
-  return nondegenerate(m, geometry);
-}
-
-// Signed volume relative to `origin`, and the sum of the absolute volumes of the fan
-// tetrahedra (the scale of the rounding error). Each face is fanned from its last
-// corner, the source of its halfedge.
-std::pair<double, double> fan_volumes(const MeshView& m, const FaceCycles& cycles,
-                                      const Point& origin) {
-  double total = 0, absolute = 0;
-  for (int f = 0; f < m.n_faces; ++f) {
-    const int n = cycles.degree(f);
-    if (n == 0) continue;  // deleted
-    const int* corners = cycles.corners(f);
-    const Point a = m.points[corners[n - 1]] - origin;
-    for (int k = 0; corners[k + 1] != corners[n - 1]; ++k) {
-      const Point b = m.points[corners[k]] - origin;
-      const Point c = m.points[corners[k + 1]] - origin;
-      const double six_v = OpenMesh::dot(a, OpenMesh::cross(b, c));
-      total += six_v;
-      absolute += std::abs(six_v);
-    }
-  }
-  return {total / 6, absolute / 6};
-}
-
-Finding outward(const MeshView& m, const Extent& extent, const FaceCycles& cycles) {
+Finding outward(const FanVolumes& volumes) {
   // OpenMesh links the two halfedges of every edge in opposite directions, so the faces
   // of a closed mesh are consistently oriented by construction; what remains is the sign.
-  const auto [volume, absolute] = fan_volumes(m, cycles, extent.centre);
-  if (!(std::abs(volume) > kFlatVolumeRatio * absolute))
+  const double volume = volumes.total / 6;
+  if (!(std::abs(volume) > kFlatVolumeRatio * (volumes.absolute / 6)))
     return fail(Verdict::invalid,
                 "the mesh encloses no volume (signed volume " + number(volume) + "): it is flat");
   if (volume < 0)
@@ -364,25 +384,20 @@ Finding outward(const MeshView& m, const Extent& extent, const FaceCycles& cycle
   return {Verdict::ok, {}, volume};
 }
 
-Finding outward(const MeshView& m) { return outward(m, bounding_box(m), face_cycles(m)); }
-
-// Planarity, then edge convexity, on the unit planes of nondegenerate().
+// Planarity (found by nondegenerate()), then edge convexity.
 Finding planar_and_convex(const MeshView& m, double relative_tolerance,
                           const Geometry& geometry) {
   const double tolerance = relative_tolerance * geometry.extent.diagonal;
   const FaceCycles& cycles = geometry.cycles;
-  for (int f = 0; f < m.n_faces; ++f) {
-    const FacePlane& plane = geometry.planes[f];
+  if (const int f = geometry.non_planar_face; f >= 0) {
     const int* corners = cycles.corners(f);
-    for (int k = 0; k < cycles.degree(f); ++k) {
-      const double distance =
-          std::abs(OpenMesh::dot(m.points[corners[k]] - plane.centroid, plane.normal));
-      if (!(distance <= tolerance))
-        return fail(Verdict::not_convex,
-                    "face " + std::to_string(f) + " is not planar: vertex " +
-                        std::to_string(corners[k]) + " is " + number(distance) +
-                        " from its plane (tolerance " + number(tolerance) + ")");
-    }
+    int k = 0;
+    while (std::abs(height(geometry.planes[f], m.points[corners[k]])) <= tolerance) ++k;
+    return fail(Verdict::not_convex,
+                "face " + std::to_string(f) + " is not planar: vertex " +
+                    std::to_string(corners[k]) + " is " +
+                    number(std::abs(height(geometry.planes[f], m.points[corners[k]]))) +
+                    " from its plane (tolerance " + number(tolerance) + ")");
   }
   for (int e = 0; e < m.n_edges; ++e) {
     if (!m.live_edge(e)) continue;
@@ -397,12 +412,12 @@ Finding planar_and_convex(const MeshView& m, double relative_tolerance,
       for (int k = 0; k < cycles.degree(g); ++k) {
         const int v = corners[k];
         if (v == from || v == to) continue;
-        const double height = OpenMesh::dot(m.points[v] - plane.centroid, plane.normal);
-        if (!(height <= tolerance))
+        const double above = height(plane, m.points[v]);
+        if (!(above <= tolerance))
           return fail(Verdict::not_convex,
                       "edge " + std::to_string(e) + " (vertices " + vertex_pair(m, e) +
                           ") is reflex: vertex " + std::to_string(v) + " of face " +
-                          std::to_string(g) + " is " + number(height) +
+                          std::to_string(g) + " is " + number(above) +
                           " above the plane of face " + std::to_string(f) + " (tolerance " +
                           number(tolerance) + ")");
       }
@@ -417,9 +432,10 @@ Finding convex_polyhedron(const Mesh& mesh, double relative_tolerance) {
   const MeshView m(mesh);
   if (Finding found = closed_manifold(m); found.verdict != Verdict::ok) return found;
   Geometry geometry;
-  if (Finding found = nondegenerate(m, geometry); found.verdict != Verdict::ok) return found;
-  if (Finding found = outward(m, geometry.extent, geometry.cycles); found.verdict != Verdict::ok)
+  if (Finding found = nondegenerate(m, relative_tolerance, geometry);
+      found.verdict != Verdict::ok)
     return found;
+  if (Finding found = outward(geometry.volumes); found.verdict != Verdict::ok) return found;
   return planar_and_convex(m, relative_tolerance, geometry);
 }
 
@@ -450,11 +466,12 @@ CheckResult check_outward_oriented(const Mesh& mesh) {
   const MeshView m(mesh);
   if (Finding found = closed_manifold(m); found.verdict != Verdict::ok)
     return {"orientation is undefined: " + found.problem, {}};
-  return to_result(outward(m));
+  return to_result(outward(fan_volumes(m, face_cycles(m), bounding_box(m).centre)));
 }
 
 CheckResult check_nondegenerate(const Mesh& mesh) {
-  return to_result(nondegenerate(MeshView(mesh)));
+  Geometry geometry;
+  return to_result(nondegenerate(MeshView(mesh), kPlanarityTolerance, geometry));
 }
 
 CheckResult check_convex_polyhedron(const Mesh& mesh, const ValidationOptions& options) {
@@ -494,7 +511,7 @@ std::optional<PreparedMesh> check_operand(const Mesh& mesh, std::string_view nam
 
 double signed_volume(const Mesh& mesh) {
   const MeshView m(mesh);
-  return fan_volumes(m, face_cycles(m), bounding_box(m).centre).first;
+  return fan_volumes(m, face_cycles(m), bounding_box(m).centre).total / 6;
 }
 
 }  // namespace morph
