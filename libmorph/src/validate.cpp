@@ -76,8 +76,8 @@ struct MeshView {
                                                                 StatusHandle handle) {
     if (!handle.is_valid()) return nullptr;
     const auto& status = m.property(handle).data_vector();
-    const bool any = std::any_of(status.begin(), status.end(),
-                                 [](const auto& s) { return s.deleted(); });
+    const bool any =
+        std::any_of(status.begin(), status.end(), [](const auto& s) { return s.deleted(); });
     return any ? status.data() : nullptr;
   }
 
@@ -91,9 +91,7 @@ struct MeshView {
   int from(int h) const { return to(h ^ 1); }
   int next(int h) const { return mesh.next_halfedge_handle(Mesh::HalfedgeHandle(h)).idx(); }
   int face(int h) const { return mesh.face_handle(Mesh::HalfedgeHandle(h)).idx(); }
-  int halfedge_of_vertex(int v) const {
-    return mesh.halfedge_handle(Mesh::VertexHandle(v)).idx();
-  }
+  int halfedge_of_vertex(int v) const { return mesh.halfedge_handle(Mesh::VertexHandle(v)).idx(); }
   int halfedge_of_face(int f) const { return mesh.halfedge_handle(Mesh::FaceHandle(f)).idx(); }
 };
 
@@ -300,7 +298,8 @@ struct FanVolumes {
 FanVolumes fan_volumes(const MeshView& m, const FaceCycles& cycles, const Point& origin) {
   FanVolumes volumes;
   for (int f = 0; f < m.n_faces; ++f)
-    if (cycles.degree(f) > 0) volumes.add_face(m.points, cycles.corners(f), cycles.degree(f), origin);
+    if (cycles.degree(f) > 0)
+      volumes.add_face(m.points, cycles.corners(f), cycles.degree(f), origin);
   return volumes;
 }
 
@@ -385,8 +384,7 @@ Finding outward(const FanVolumes& volumes) {
 }
 
 // Planarity (found by nondegenerate()), then edge convexity.
-Finding planar_and_convex(const MeshView& m, double relative_tolerance,
-                          const Geometry& geometry) {
+Finding planar_and_convex(const MeshView& m, double relative_tolerance, const Geometry& geometry) {
   const double tolerance = relative_tolerance * geometry.extent.diagonal;
   const FaceCycles& cycles = geometry.cycles;
   if (const int f = geometry.non_planar_face; f >= 0) {
@@ -417,9 +415,8 @@ Finding planar_and_convex(const MeshView& m, double relative_tolerance,
           return fail(Verdict::not_convex,
                       "edge " + std::to_string(e) + " (vertices " + vertex_pair(m, e) +
                           ") is reflex: vertex " + std::to_string(v) + " of face " +
-                          std::to_string(g) + " is " + number(above) +
-                          " above the plane of face " + std::to_string(f) + " (tolerance " +
-                          number(tolerance) + ")");
+                          std::to_string(g) + " is " + number(above) + " above the plane of face " +
+                          std::to_string(f) + " (tolerance " + number(tolerance) + ")");
       }
     }
   }
@@ -432,8 +429,7 @@ Finding convex_polyhedron(const Mesh& mesh, double relative_tolerance) {
   const MeshView m(mesh);
   if (Finding found = closed_manifold(m); found.verdict != Verdict::ok) return found;
   Geometry geometry;
-  if (Finding found = nondegenerate(m, relative_tolerance, geometry);
-      found.verdict != Verdict::ok)
+  if (Finding found = nondegenerate(m, relative_tolerance, geometry); found.verdict != Verdict::ok)
     return found;
   if (Finding found = outward(geometry.volumes); found.verdict != Verdict::ok) return found;
   return planar_and_convex(m, relative_tolerance, geometry);
