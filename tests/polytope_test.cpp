@@ -253,3 +253,29 @@ TEST_CASE("polytope: make_operand keeps the messages of prepare_convex_polyhedro
     CHECK(std::string(error.what()) == expected);
   }
 }
+
+TEST_CASE("polytope: two triangles a hair from coplanar stay apart when convex, merge when not") {
+  // The unit cube in triangles; its bottom quad 0-2-3-1 (z = 0) is split along 0-3. Moving
+  // vertex 0 by eps along -z keeps its side faces in their planes and bends the bottom
+  // along 0-3: outwards (eps > 0) a strictly convex ridge, so the bottom stays two facets;
+  // inwards (eps < 0) a valley, merged into one facet (convex within the tolerance). The
+  // larger bend is decided in double, the smaller one needs the exact fallback.
+  for (const double eps : {0x1p-45, 0x1p-60, -0x1p-45, -0x1p-60}) {
+    CAPTURE(eps);
+    std::vector<Point> points;
+    for (int i = 0; i < 8; ++i) points.push_back(Point(i & 1, (i >> 1) & 1, (i >> 2) & 1));
+    points[0][2] = -eps;
+    std::vector<std::vector<int>> triangles;
+    for (const auto& q : std::vector<std::vector<int>>{
+             {0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}}) {
+      triangles.push_back({q[0], q[1], q[2]});
+      triangles.push_back({q[0], q[2], q[3]});
+    }
+    const Mesh mesh = morph::test::mesh_from_polygons(points, triangles);
+    REQUIRE(morph::check_convex_polyhedron(mesh).ok());
+    const Polytope p = morph::detail::make_operand(mesh, "A");
+    CHECK(p.num_faces() == (eps > 0 ? 7 : 6));
+    CHECK(p.num_vertices() == 8);
+    check_both_paths(mesh, "bent cube");
+  }
+}

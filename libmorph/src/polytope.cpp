@@ -356,8 +356,47 @@ void build_connectivity(Polytope& p, const std::vector<std::vector<int>>& faces,
       fail(name, "vertex " + std::to_string(v) + " is not manifold");
 }
 
+// Relative error bound of Shewchuk's orient3d evaluated in double, (7 + 56 eps) eps, with
+// eps = 2^-52 (one ulp per operation) so that it holds in any rounding mode: is_canonical
+// runs under a RoundingGuard, which rounds upward.
+constexpr double kOrient3dErrorBound = (7.0 + 56.0 * 0x1p-52) * 0x1p-52;
+// Below this permanent, products may underflow and the relative bound no longer holds.
+constexpr double kOrient3dMinPermanent = 1e-280;
+
+/// The vertex of triangle f other than u and w.
+int third_vertex(const Polytope& p, int f, int u, int w) {
+  const int* c = &p.corner_vertex[p.face_begin[f]];
+  return c[0] != u && c[0] != w ? c[0] : c[1] != u && c[1] != w ? c[1] : c[2];
+}
+
+/// edge_convexity() between two triangles of double points, decided in double when a
+/// static bound allows, else 2. With d = to - from and the far vertices a (of left) and b
+/// (of right), N_left = d x (a - from) and N_right = (b - from) x d, so that
+/// det(N_left, N_right, d) = -|d|^2 det(d, a - from, b - from): one orientation.
+int triangle_edge_convexity(const Polytope& p, const Polytope::Edge& e) {
+  const V3<double>& o = p.points[e.from];
+  const V3<double> d = p.points[e.to] - o;
+  const V3<double> a = p.points[third_vertex(p, e.left, e.from, e.to)] - o;
+  const V3<double> b = p.points[third_vertex(p, e.right, e.from, e.to)] - o;
+  const double ab_x = a.y * b.z - a.z * b.y, ab_y = a.z * b.x - a.x * b.z,
+               ab_z = a.x * b.y - a.y * b.x;
+  const double orientation = d.x * ab_x + d.y * ab_y + d.z * ab_z;
+  using std::abs;
+  const double permanent = abs(d.x) * (abs(a.y * b.z) + abs(a.z * b.y)) +
+                           abs(d.y) * (abs(a.z * b.x) + abs(a.x * b.z)) +
+                           abs(d.z) * (abs(a.x * b.y) + abs(a.y * b.x));
+  if (!(permanent >= kOrient3dMinPermanent)) return 2;  // also NaN
+  const double bound = kOrient3dErrorBound * permanent;
+  if (orientation > bound) return -1;
+  if (orientation < -bound) return 1;
+  return 2;
+}
+
 /// Sign of det(N_left, N_right, to - from): positive when the edge is strictly convex.
 int edge_convexity(const Polytope& p, const Polytope::Edge& e) {
+  if (p.exact_points.empty() && p.degree(e.left) == 3 && p.degree(e.right) == 3) {
+    if (const int s = triangle_edge_convexity(p, e); s != 2) return s;
+  }
   const int s = interval_sign(det(p.normals[e.left], p.normals[e.right],
                                   p.interval_point(e.to) - p.interval_point(e.from)));
   if (s != 2) return s;
@@ -441,35 +480,34 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   p.face_begin[nf] = c;
   if (c != nh) throw error("internal error: a mesh halfedge has no face");
   const int nc = c;
-  // twin[c]: the corner of the other facet on c's edge (its halfedge is the opposite one;
-  // OpenMesh stores the two halfedges of edge e as 2e and 2e + 1).
-  std::vector<int> twin(nc);
-  for (c = 0; c < nc; ++c) twin[c] = corner_of[corner_halfedge[c] ^ 1];
-  auto next_corner = [&](int k) {
-    return k + 1 == p.face_begin[corner_face[k] + 1] ? p.face_begin[corner_face[k]] : k + 1;
-  };
-  auto prev_corner = [&](int k) {
-    return k == p.face_begin[corner_face[k]] ? p.face_begin[corner_face[k] + 1] - 1 : k - 1;
-  };
-
-  std::vector<int> edge_of(mesh.n_edges(), -1), mesh_edge;
+  // The corner of the other facet on c's edge (its halfedge is the opposite one; OpenMesh
+  // stores the two halfedges of edge e as 2e and 2e + 1). Its vertex is the other end of
+  // c's edge, in either order.
+  auto twin = [&](int k) { return corner_of[corner_halfedge[k] ^ 1]; };
+  // Edges in order of first use: an edge is first used by the smaller of its two corners.
+  std::vector<int> mesh_edge;
   mesh_edge.reserve(mesh.n_edges());
   p.edges.clear();
   p.edges.reserve(mesh.n_edges());
   p.corner_edge.resize(nc);
   for (c = 0; c < nc; ++c) {
-    int& e = edge_of[corner_halfedge[c] >> 1];
-    if (e < 0) {
-      e = static_cast<int>(p.edges.size());
-      p.edges.push_back({p.corner_vertex[c], p.corner_vertex[next_corner(c)], corner_face[c],
-                         corner_face[twin[c]]});
-      mesh_edge.push_back(corner_halfedge[c] >> 1);
-    }
+    const int t = twin(c);
+    if (t < c) continue;  // numbered at t
+    const int e = static_cast<int>(p.edges.size());
+    p.edges.push_back({p.corner_vertex[c], p.corner_vertex[t], corner_face[c], corner_face[t]});
+    mesh_edge.push_back(corner_halfedge[c] >> 1);
     p.corner_edge[c] = e;
+    p.corner_edge[t] = e;
   }
 
   // Fans, walked as build_connectivity does: from the last corner at v, the next facet
-  // counter-clockwise is across the incoming edge u -> v.
+  // counter-clockwise is across the incoming edge u -> v, at corner fan_next[c] =
+  // twin(prev_corner(c)); precomputed so that the walk follows one link per step.
+  std::vector<int> fan_next(nc);
+  for (int f = 0; f < nf; ++f) {
+    const int b = p.face_begin[f], end = p.face_begin[f + 1];
+    for (c = b; c < end; ++c) fan_next[c] = twin(c == b ? end - 1 : c - 1);
+  }
   std::vector<int> some_corner(nv, -1);
   for (c = 0; c < nc; ++c) some_corner[p.corner_vertex[c]] = c;
   p.fan_begin.resize(nv + 1);
@@ -484,12 +522,13 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
     c = first;
     do {
       if (slot == nc) throw error("internal error: a mesh vertex has a broken fan");
-      const int pc = prev_corner(c);
-      p.fan_face[slot] = corner_face[c];
+      const int f = corner_face[c];
+      const int pc = c == p.face_begin[f] ? p.face_begin[f + 1] - 1 : c - 1;
+      p.fan_face[slot] = f;
       p.fan_edge[slot] = p.corner_edge[pc];
       p.fan_vertex[slot] = p.corner_vertex[pc];
       ++slot;
-      c = twin[pc];
+      c = fan_next[c];
     } while (c != first);
   }
   p.fan_begin[nv] = slot;
@@ -497,14 +536,16 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   return mesh_edge;
 }
 
+// Whether any vertex, edge or face is marked deleted (read straight from the status
+// arrays: OpenMesh's status() looks the property up on every call).
 bool has_deleted_elements(const Mesh& mesh) {
-  for (auto v : mesh.all_vertices())
-    if (mesh.status(v).deleted()) return true;
-  for (auto e : mesh.all_edges())
-    if (mesh.status(e).deleted()) return true;
-  for (auto f : mesh.all_faces())
-    if (mesh.status(f).deleted()) return true;
-  return false;
+  const auto any_deleted = [&](const auto& status_handle) {
+    const auto& status = mesh.property(status_handle).data_vector();
+    return std::any_of(status.begin(), status.end(), [](const auto& s) { return s.deleted(); });
+  };
+  return (mesh.has_vertex_status() && any_deleted(mesh.vertex_status_pph())) ||
+         (mesh.has_edge_status() && any_deleted(mesh.edge_status_pph())) ||
+         (mesh.has_face_status() && any_deleted(mesh.face_status_pph()));
 }
 
 }  // namespace
@@ -694,10 +735,8 @@ Polytope make_polytope(const Mesh& mesh, const char* name, FaceOrder order) {
   if (has_deleted_elements(mesh)) return make_polytope_from_cycles(mesh, name, order);
   Polytope p;
   p.points.resize(mesh.n_vertices());
-  for (auto v : mesh.vertices()) {
-    const auto& q = mesh.point(v);
-    p.points[v.idx()] = {q[0], q[1], q[2]};
-  }
+  const Point* q = mesh.points();
+  for (int v = 0; v < p.num_vertices(); ++v) p.points[v] = {q[v][0], q[v][1], q[v][2]};
   std::vector<int> mesh_edge = connectivity_from_halfedges(p, mesh, order);
   p.compute_normals();
   if (!is_canonical(p)) return make_polytope_from_cycles(mesh, name, order);

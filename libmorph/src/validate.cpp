@@ -47,10 +47,56 @@ std::string number(double value) {
   return buffer;
 }
 
-std::string vertex_pair(const Mesh& mesh, Mesh::EdgeHandle edge) {
-  const auto h = mesh.halfedge_handle(edge, 0);
-  return std::to_string(mesh.from_vertex_handle(h).idx()) + "-" +
-         std::to_string(mesh.to_vertex_handle(h).idx());
+// The mesh's arrays read by plain index. OpenMesh's skipping iterators and its
+// per-element property look-ups (point(), status()) cost more than the checks themselves,
+// so each array is looked up once here. Element counts include deleted elements, which
+// the checks skip exactly as OpenMesh's iterators do.
+struct MeshView {
+  explicit MeshView(const Mesh& m)
+      : mesh(m),
+        points(m.points()),
+        n_vertices(static_cast<int>(m.n_vertices())),
+        n_edges(static_cast<int>(m.n_edges())),
+        n_halfedges(static_cast<int>(m.n_halfedges())),
+        n_faces(static_cast<int>(m.n_faces())),
+        vertex_status(deleted_status(m, m.vertex_status_pph())),
+        edge_status(deleted_status(m, m.edge_status_pph())),
+        halfedge_status(deleted_status(m, m.halfedge_status_pph())),
+        face_status(deleted_status(m, m.face_status_pph())) {}
+
+  const Mesh& mesh;
+  const Point* points;
+  int n_vertices, n_edges, n_halfedges, n_faces;
+  // Null when no element of that kind is deleted (or the kind has no status).
+  const OpenMesh::Attributes::StatusInfo *vertex_status, *edge_status, *halfedge_status,
+      *face_status;
+
+  template <class StatusHandle>
+  static const OpenMesh::Attributes::StatusInfo* deleted_status(const Mesh& m,
+                                                                StatusHandle handle) {
+    if (!handle.is_valid()) return nullptr;
+    const auto& status = m.property(handle).data_vector();
+    const bool any =
+        std::any_of(status.begin(), status.end(), [](const auto& s) { return s.deleted(); });
+    return any ? status.data() : nullptr;
+  }
+
+  bool live_vertex(int v) const { return !vertex_status || !vertex_status[v].deleted(); }
+  bool live_edge(int e) const { return !edge_status || !edge_status[e].deleted(); }
+  bool live_halfedge(int h) const { return !halfedge_status || !halfedge_status[h].deleted(); }
+  bool live_face(int f) const { return !face_status || !face_status[f].deleted(); }
+
+  // OpenMesh stores the two halfedges of edge e as 2e and 2e + 1.
+  int to(int h) const { return mesh.to_vertex_handle(Mesh::HalfedgeHandle(h)).idx(); }
+  int from(int h) const { return to(h ^ 1); }
+  int next(int h) const { return mesh.next_halfedge_handle(Mesh::HalfedgeHandle(h)).idx(); }
+  int face(int h) const { return mesh.face_handle(Mesh::HalfedgeHandle(h)).idx(); }
+  int halfedge_of_vertex(int v) const { return mesh.halfedge_handle(Mesh::VertexHandle(v)).idx(); }
+  int halfedge_of_face(int f) const { return mesh.halfedge_handle(Mesh::FaceHandle(f)).idx(); }
+};
+
+std::string vertex_pair(const MeshView& m, int edge) {
+  return std::to_string(m.from(2 * edge)) + "-" + std::to_string(m.to(2 * edge));
 }
 
 // Diagonal of the axis-aligned bounding box of the (non-deleted) vertices, and its centre.
@@ -59,104 +105,142 @@ struct Extent {
   Point centre{0, 0, 0};
 };
 
-Extent bounding_box(const Mesh& mesh) {
+Extent bounding_box(const MeshView& m) {
   constexpr double inf = std::numeric_limits<double>::infinity();
   Point lo(inf, inf, inf), hi(-inf, -inf, -inf);
   bool any = false;
-  for (auto v : mesh.vertices()) {
-    lo.minimize(mesh.point(v));
-    hi.maximize(mesh.point(v));
+  for (int v = 0; v < m.n_vertices; ++v) {
+    if (!m.live_vertex(v)) continue;
+    lo.minimize(m.points[v]);
+    hi.maximize(m.points[v]);
     any = true;
   }
   if (!any) return {};
   return {(hi - lo).norm(), (lo + hi) * 0.5};
 }
 
-// ---------------------------------------------------------------- topology
-
-// Plain union-find over vertex indices, for connectivity.
-struct DisjointSets {
-  std::vector<int> parent;
-  explicit DisjointSets(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-  int find(int x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  }
-  void unite(int a, int b) { parent[find(a)] = find(b); }
+// The vertex cycle of every live face, in the order of its vertex circulator (starting
+// at the target of the face's halfedge), read once for all the geometric checks. A
+// deleted face has an empty cycle.
+struct FaceCycles {
+  std::vector<int> begin;   // size F + 1, over all faces
+  std::vector<int> vertex;  // corner k of face f: vertex[begin[f] + k]
+  int degree(int f) const { return begin[f + 1] - begin[f]; }
+  const int* corners(int f) const { return vertex.data() + begin[f]; }
 };
 
-Finding closed_manifold(const Mesh& mesh) {
-  std::size_t n_vertices = 0, n_edges = 0, n_faces = 0;
-  for (auto f : mesh.faces()) {
-    (void)f;
-    ++n_faces;
+FaceCycles face_cycles(const MeshView& m) {
+  FaceCycles cycles;
+  cycles.begin.resize(m.n_faces + 1);
+  cycles.vertex.reserve(m.n_halfedges);
+  for (int f = 0; f < m.n_faces; ++f) {
+    cycles.begin[f] = static_cast<int>(cycles.vertex.size());
+    if (!m.live_face(f)) continue;
+    const int first = m.halfedge_of_face(f);
+    int h = first;
+    do {
+      if (static_cast<int>(cycles.vertex.size()) == m.n_halfedges)
+        throw error("internal error: mesh face " + std::to_string(f) +
+                    " is not a closed cycle of halfedges");
+      cycles.vertex.push_back(m.to(h));
+      h = m.next(h);
+    } while (h != first);
   }
+  cycles.begin[m.n_faces] = static_cast<int>(cycles.vertex.size());
+  return cycles;
+}
+
+// ---------------------------------------------------------------- topology
+
+Finding closed_manifold(const MeshView& m) {
+  long long n_vertices = 0, n_edges = 0, n_faces = 0;
+  for (int f = 0; f < m.n_faces; ++f) n_faces += m.live_face(f);
   if (n_faces == 0) return fail(Verdict::invalid, "the mesh is empty (it has no faces)");
 
-  for (auto e : mesh.edges()) {
+  for (int e = 0; e < m.n_edges; ++e) {
+    if (!m.live_edge(e)) continue;
     ++n_edges;
-    if (mesh.is_boundary(e))
-      return fail(Verdict::invalid, "edge " + std::to_string(e.idx()) + " (vertices " +
-                                        vertex_pair(mesh, e) +
+    if (m.face(2 * e) < 0 || m.face(2 * e + 1) < 0)
+      return fail(Verdict::invalid, "edge " + std::to_string(e) + " (vertices " +
+                                        vertex_pair(m, e) +
                                         ") has only one face: the mesh is not closed");
   }
 
   // A vertex is manifold when the faces around it form one fan: the circulator around
   // it (which walks one fan) must meet every halfedge leaving it, and reach each
   // neighbour once (two edges between the same vertices pinch the surface).
-  std::vector<int> outgoing(mesh.n_vertices(), 0);
-  for (auto h : mesh.halfedges()) ++outgoing[mesh.from_vertex_handle(h).idx()];
+  std::vector<int> outgoing(m.n_vertices, 0);
+  for (int h = 0; h < m.n_halfedges; ++h)
+    if (m.live_halfedge(h)) ++outgoing[m.from(h)];
+  enum class Fan : char { unreached, queued, one, isolated, several, pinched };
   // seen[w] == v: w was already reached from v (a stamp, so the array is never cleared).
-  std::vector<int> seen(mesh.n_vertices(), -1);
-  for (auto v : mesh.vertices()) {
-    ++n_vertices;
-    if (outgoing[v.idx()] == 0)
-      return fail(Verdict::invalid,
-                  "vertex " + std::to_string(v.idx()) + " is isolated (it belongs to no face)");
+  std::vector<int> seen(m.n_vertices, -1);
+  // Walks the fan of v, calling visit(w) for each neighbour w it reaches.
+  const auto walk_fan = [&](int v, const auto& visit) {
+    if (outgoing[v] == 0) return Fan::isolated;
     int reached = 0;
     bool pinched = false;
     // The outgoing halfedges around v, as the circulator walks them.
-    const auto first = mesh.halfedge_handle(v);
-    auto h = first;
+    const int first = m.halfedge_of_vertex(v);
+    int h = first;
     do {
-      const int w = mesh.to_vertex_handle(h).idx();
-      pinched = pinched || seen[w] == v.idx();
-      seen[w] = v.idx();
-      if (++reached > outgoing[v.idx()]) break;  // corrupt links
-      h = mesh.next_halfedge_handle(mesh.opposite_halfedge_handle(h));
+      const int w = m.to(h);
+      visit(w);
+      pinched = pinched || seen[w] == v;
+      seen[w] = v;
+      if (++reached > outgoing[v]) break;  // corrupt links
+      h = m.next(h ^ 1);
     } while (h != first);
-    if (reached != outgoing[v.idx()])
-      return fail(Verdict::invalid, "vertex " + std::to_string(v.idx()) +
+    if (reached != outgoing[v]) return Fan::several;
+    return pinched ? Fan::pinched : Fan::one;
+  };
+
+  // Each fan is walked once, in a search from the first vertex that also finds the
+  // vertices connected to it (through the fans, which hold every edge once the vertices
+  // pass); then the vertices are judged in index order, as the rule lists them.
+  int first = 0;
+  while (first < m.n_vertices && !m.live_vertex(first)) ++first;
+  std::vector<Fan> fan(m.n_vertices, Fan::unreached);
+  std::vector<int> stack;
+  const auto reach = [&](int w) {
+    if (fan[w] != Fan::unreached) return;
+    fan[w] = Fan::queued;
+    stack.push_back(w);
+  };
+  if (first < m.n_vertices) reach(first);
+  while (!stack.empty()) {
+    const int v = stack.back();
+    stack.pop_back();
+    fan[v] = walk_fan(v, reach);
+  }
+  for (int v = 0; v < m.n_vertices; ++v) {
+    if (!m.live_vertex(v)) continue;
+    ++n_vertices;
+    const Fan found = fan[v] == Fan::unreached ? walk_fan(v, [](int) {}) : fan[v];
+    if (found == Fan::isolated)
+      return fail(Verdict::invalid,
+                  "vertex " + std::to_string(v) + " is isolated (it belongs to no face)");
+    if (found == Fan::several)
+      return fail(Verdict::invalid, "vertex " + std::to_string(v) +
                                         " is not manifold: its faces form more than one fan");
-    if (pinched) {
+    if (found == Fan::pinched) {
       // Name the smallest neighbour reached twice.
       std::vector<int> neighbours;
-      for (auto h : mesh.voh_range(v)) neighbours.push_back(mesh.to_vertex_handle(h).idx());
+      for (auto oh : m.mesh.voh_range(Mesh::VertexHandle(v)))
+        neighbours.push_back(m.mesh.to_vertex_handle(oh).idx());
       std::sort(neighbours.begin(), neighbours.end());
       const auto twice = std::adjacent_find(neighbours.begin(), neighbours.end());
-      return fail(Verdict::invalid, "vertices " + std::to_string(v.idx()) + " and " +
+      return fail(Verdict::invalid, "vertices " + std::to_string(v) + " and " +
                                         std::to_string(*twice) +
                                         " are joined by two edges: the mesh is not 2-manifold");
     }
   }
-
-  DisjointSets components(mesh.n_vertices());
-  for (auto e : mesh.edges()) {
-    const auto h = mesh.halfedge_handle(e, 0);
-    components.unite(mesh.from_vertex_handle(h).idx(), mesh.to_vertex_handle(h).idx());
-  }
-  int first = -1;
-  for (auto v : mesh.vertices()) {
-    if (first < 0) {
-      first = v.idx();
-    } else if (components.find(v.idx()) != components.find(first)) {
-      return fail(Verdict::invalid, "the mesh is not connected: vertex " + std::to_string(v.idx()) +
+  for (int v = first + 1; v < m.n_vertices; ++v)
+    if (m.live_vertex(v) && fan[v] == Fan::unreached)
+      return fail(Verdict::invalid, "the mesh is not connected: vertex " + std::to_string(v) +
                                         " is not connected to vertex " + std::to_string(first));
-    }
-  }
 
-  const long long euler = static_cast<long long>(n_vertices) - static_cast<long long>(n_edges) +
-                          static_cast<long long>(n_faces);
+  const long long euler = n_vertices - n_edges + n_faces;
   if (euler != 2)
     return fail(Verdict::invalid,
                 "the mesh has genus " + std::to_string((2 - euler) / 2) +
@@ -176,116 +260,121 @@ struct FacePlane {
   Point normal{0, 0, 0};  // unit length once the face is known to be non-degenerate
 };
 
-// What the geometric checks share: the extent, and every face's plane (its Newell
-// normal not yet normalised), computed once by nondegenerate().
-struct Geometry {
-  Extent extent;
-  std::vector<FacePlane> planes;  // by face index
-};
-
-// The vertices of face f in the order of its vertex circulator (starting at the target
-// of the face's halfedge), without the circulator's overhead.
-template <class Visit>
-void for_each_corner(const Mesh& mesh, Mesh::FaceHandle f, const Visit& visit) {
-  const auto first = mesh.halfedge_handle(f);
-  auto h = first;
-  do {
-    visit(mesh.to_vertex_handle(h));
-    h = mesh.next_halfedge_handle(h);
-  } while (h != first);
-}
-
-FacePlane newell_plane(const std::vector<Point>& corners) {
+FacePlane newell_plane(const Point* points, const int* corners, int n) {
   FacePlane plane;
-  for (const auto& p : corners) plane.centroid += p;
-  plane.centroid /= static_cast<double>(corners.size());
-  for (std::size_t i = 0; i < corners.size(); ++i) {
-    const Point a = corners[i] - plane.centroid;
-    const Point b = corners[i + 1 == corners.size() ? 0 : i + 1] - plane.centroid;
+  for (int i = 0; i < n; ++i) plane.centroid += points[corners[i]];
+  plane.centroid *= 1.0 / n;
+  for (int i = 0; i < n; ++i) {
+    const Point a = points[corners[i]] - plane.centroid;
+    const Point b = points[corners[i + 1 == n ? 0 : i + 1]] - plane.centroid;
     plane.normal += OpenMesh::cross(a, b);
   }
   return plane;
 }
 
-// Whether two of `values` are equal (quadratic: faces are small; sorting would allocate).
-template <class T>
-bool has_equal_pair(const std::vector<T>& values) {
-  for (std::size_t i = 0; i < values.size(); ++i)
-    for (std::size_t j = i + 1; j < values.size(); ++j)
-      if (values[i] == values[j]) return true;
-  return false;
+// Signed distance of p above a face's plane.
+double height(const FacePlane& plane, const Point& p) {
+  return OpenMesh::dot(p - plane.centroid, plane.normal);
 }
 
-// Fills `geometry` (extent and face planes) for the later checks when the mesh passes.
-Finding nondegenerate(const Mesh& mesh, Geometry& geometry) {
-  for (auto v : mesh.vertices()) {
-    const Point& p = mesh.point(v);
-    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
-      return fail(Verdict::invalid,
-                  "vertex " + std::to_string(v.idx()) + " has a coordinate that is not finite");
-  }
-  geometry.extent = bounding_box(mesh);
-  const double diagonal = geometry.extent.diagonal;
-  geometry.planes.assign(mesh.n_faces(), FacePlane{});
-  std::vector<Point> corners;
-  std::vector<int> ids;
-  for (auto f : mesh.faces()) {
-    ids.clear();
-    corners.clear();
-    for_each_corner(mesh, f, [&](Mesh::VertexHandle v) {
-      ids.push_back(v.idx());
-      corners.push_back(mesh.point(v));
-    });
-    const auto face = [&] { return "face " + std::to_string(f.idx()); };
-    if (ids.size() < 3)
-      return fail(Verdict::invalid, face() + " has " + std::to_string(ids.size()) +
-                                        " vertices; a face needs at least 3");
-    if (has_equal_pair(ids)) {
-      std::sort(ids.begin(), ids.end());
-      const auto twice = std::adjacent_find(ids.begin(), ids.end());
-      return fail(Verdict::invalid,
-                  face() + " uses vertex " + std::to_string(*twice) + " more than once");
-    }
-    const FacePlane plane = newell_plane(corners);
-    if (has_equal_pair(corners))
-      return fail(Verdict::invalid, face() + " has two vertices at the same position");
-    if (!(plane.normal.norm() > kZeroAreaRatio * diagonal * diagonal))
-      return fail(Verdict::invalid, face() + " has zero area (its vertices are collinear)");
-    geometry.planes[f.idx()] = plane;
-  }
-  return {};
-}
-
-Finding nondegenerate(const Mesh& mesh) {
-  Geometry geometry;
-  return nondegenerate(mesh, geometry);
-}
-
-// Signed volume relative to `origin`, and the sum of the absolute volumes of the fan
-// tetrahedra (the scale of the rounding error).
-std::pair<double, double> fan_volumes(const Mesh& mesh, const Point& origin) {
+// Six times the signed volume about an origin, and six times the sum of the absolute
+// volumes of the fan tetrahedra (the scale of the rounding error).
+struct FanVolumes {
   double total = 0, absolute = 0;
-  for (auto f : mesh.faces()) {
-    auto h = mesh.halfedge_handle(f);
-    const Point a = mesh.point(mesh.from_vertex_handle(h)) - origin;
-    for (h = mesh.next_halfedge_handle(h);
-         mesh.to_vertex_handle(h) != mesh.from_vertex_handle(mesh.halfedge_handle(f));
-         h = mesh.next_halfedge_handle(h)) {
-      const Point b = mesh.point(mesh.from_vertex_handle(h)) - origin;
-      const Point c = mesh.point(mesh.to_vertex_handle(h)) - origin;
+
+  // Adds the fan of a face from its last corner (the source of its halfedge).
+  void add_face(const Point* points, const int* corners, int n, const Point& origin) {
+    const Point a = points[corners[n - 1]] - origin;
+    for (int k = 0; corners[k + 1] != corners[n - 1]; ++k) {
+      const Point b = points[corners[k]] - origin;
+      const Point c = points[corners[k + 1]] - origin;
       const double six_v = OpenMesh::dot(a, OpenMesh::cross(b, c));
       total += six_v;
       absolute += std::abs(six_v);
     }
   }
-  return {total / 6, absolute / 6};
+};
+
+FanVolumes fan_volumes(const MeshView& m, const FaceCycles& cycles, const Point& origin) {
+  FanVolumes volumes;
+  for (int f = 0; f < m.n_faces; ++f)
+    if (cycles.degree(f) > 0)
+      volumes.add_face(m.points, cycles.corners(f), cycles.degree(f), origin);
+  return volumes;
 }
 
-Finding outward(const Mesh& mesh, const Extent& extent) {
+// What the geometric checks share, gathered in one pass over the faces by
+// nondegenerate(): the extent, the face cycles and unit planes, the fan volumes about the
+// extent's centre, and the first face that is not planar (reported only after the
+// orientation, as the rule orders them).
+struct Geometry {
+  Extent extent;
+  FaceCycles cycles;
+  std::vector<FacePlane> planes;  // by face index
+  FanVolumes volumes;
+  int non_planar_face = -1;
+};
+
+// Whether two of the n values key(0), ..., key(n - 1) are equal (quadratic: faces are
+// small; sorting would allocate).
+template <class Key>
+bool has_equal_pair(int n, const Key& key) {
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j)
+      if (key(i) == key(j)) return true;
+  return false;
+}
+
+// Fills `geometry` for the later checks when the mesh passes; planarity is judged with
+// `relative_tolerance` times the bounding-box diagonal.
+Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& geometry) {
+  for (int v = 0; v < m.n_vertices; ++v) {
+    if (!m.live_vertex(v)) continue;
+    const Point& p = m.points[v];
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+      return fail(Verdict::invalid,
+                  "vertex " + std::to_string(v) + " has a coordinate that is not finite");
+  }
+  geometry.extent = bounding_box(m);
+  const double diagonal = geometry.extent.diagonal;
+  const double tolerance = relative_tolerance * diagonal;
+  geometry.cycles = face_cycles(m);
+  geometry.planes.resize(m.n_faces);
+  for (int f = 0; f < m.n_faces; ++f) {
+    if (!m.live_face(f)) continue;
+    const int* ids = geometry.cycles.corners(f);
+    const int n = geometry.cycles.degree(f);
+    const auto face = [&] { return "face " + std::to_string(f); };
+    if (n < 3)
+      return fail(Verdict::invalid,
+                  face() + " has " + std::to_string(n) + " vertices; a face needs at least 3");
+    if (has_equal_pair(n, [&](int i) { return ids[i]; })) {
+      std::vector<int> sorted(ids, ids + n);
+      std::sort(sorted.begin(), sorted.end());
+      const auto twice = std::adjacent_find(sorted.begin(), sorted.end());
+      return fail(Verdict::invalid,
+                  face() + " uses vertex " + std::to_string(*twice) + " more than once");
+    }
+    FacePlane& plane = geometry.planes[f];
+    plane = newell_plane(m.points, ids, n);
+    if (has_equal_pair(n, [&](int i) -> const Point& { return m.points[ids[i]]; }))
+      return fail(Verdict::invalid, face() + " has two vertices at the same position");
+    const double length = plane.normal.norm();
+    if (!(length > kZeroAreaRatio * diagonal * diagonal))
+      return fail(Verdict::invalid, face() + " has zero area (its vertices are collinear)");
+    plane.normal *= 1.0 / length;
+    geometry.volumes.add_face(m.points, ids, n, geometry.extent.centre);
+    for (int k = 0; k < n && geometry.non_planar_face < 0; ++k)
+      if (!(std::abs(height(plane, m.points[ids[k]])) <= tolerance)) geometry.non_planar_face = f;
+  }
+  return {};
+}
+
+Finding outward(const FanVolumes& volumes) {
   // OpenMesh links the two halfedges of every edge in opposite directions, so the faces
   // of a closed mesh are consistently oriented by construction; what remains is the sign.
-  const auto [volume, absolute] = fan_volumes(mesh, extent.centre);
-  if (!(std::abs(volume) > kFlatVolumeRatio * absolute))
+  const double volume = volumes.total / 6;
+  if (!(std::abs(volume) > kFlatVolumeRatio * (volumes.absolute / 6)))
     return fail(Verdict::invalid,
                 "the mesh encloses no volume (signed volume " + number(volume) + "): it is flat");
   if (volume < 0)
@@ -294,52 +383,41 @@ Finding outward(const Mesh& mesh, const Extent& extent) {
   return {Verdict::ok, {}, volume};
 }
 
-Finding outward(const Mesh& mesh) { return outward(mesh, bounding_box(mesh)); }
-
-// Planarity, then edge convexity; `geometry` from nondegenerate(), its planes normalised
-// here.
-Finding planar_and_convex(const Mesh& mesh, double relative_tolerance, Geometry& geometry) {
+// Planarity (found by nondegenerate()), then edge convexity.
+Finding planar_and_convex(const MeshView& m, double relative_tolerance, const Geometry& geometry) {
   const double tolerance = relative_tolerance * geometry.extent.diagonal;
-  std::vector<FacePlane>& planes = geometry.planes;
-  for (auto f : mesh.faces()) {
-    FacePlane& plane = planes[f.idx()];
-    plane.normal.normalize();
-    Mesh::VertexHandle off_plane;
-    double distance = 0;
-    for_each_corner(mesh, f, [&](Mesh::VertexHandle v) {
-      if (off_plane.is_valid()) return;
-      distance = std::abs(OpenMesh::dot(mesh.point(v) - plane.centroid, plane.normal));
-      if (!(distance <= tolerance)) off_plane = v;
-    });
-    if (off_plane.is_valid())
-      return fail(Verdict::not_convex,
-                  "face " + std::to_string(f.idx()) + " is not planar: vertex " +
-                      std::to_string(off_plane.idx()) + " is " + number(distance) +
-                      " from its plane (tolerance " + number(tolerance) + ")");
+  const FaceCycles& cycles = geometry.cycles;
+  if (const int f = geometry.non_planar_face; f >= 0) {
+    const int* corners = cycles.corners(f);
+    int k = 0;
+    while (std::abs(height(geometry.planes[f], m.points[corners[k]])) <= tolerance) ++k;
+    return fail(Verdict::not_convex,
+                "face " + std::to_string(f) + " is not planar: vertex " +
+                    std::to_string(corners[k]) + " is " +
+                    number(std::abs(height(geometry.planes[f], m.points[corners[k]]))) +
+                    " from its plane (tolerance " + number(tolerance) + ")");
   }
-  for (auto e : mesh.edges()) {
+  for (int e = 0; e < m.n_edges; ++e) {
+    if (!m.live_edge(e)) continue;
     for (int side = 0; side < 2; ++side) {
-      const auto h = mesh.halfedge_handle(e, side);
-      const auto f = mesh.face_handle(h);
-      const auto g = mesh.opposite_face_handle(h);
-      const FacePlane& plane = planes[f.idx()];
+      const int h = 2 * e + side;
+      const int f = m.face(h), g = m.face(h ^ 1);
+      const FacePlane& plane = geometry.planes[f];
       // The edge's own vertices belong to f and passed the planarity check: their height
       // is at most the tolerance, so only g's other vertices can fail.
-      const auto from = mesh.from_vertex_handle(h), to = mesh.to_vertex_handle(h);
-      Mesh::VertexHandle above;
-      double height = 0;
-      for_each_corner(mesh, g, [&](Mesh::VertexHandle v) {
-        if (above.is_valid() || v == from || v == to) return;
-        height = OpenMesh::dot(mesh.point(v) - plane.centroid, plane.normal);
-        if (!(height <= tolerance)) above = v;
-      });
-      if (above.is_valid())
-        return fail(Verdict::not_convex, "edge " + std::to_string(e.idx()) + " (vertices " +
-                                             vertex_pair(mesh, e) + ") is reflex: vertex " +
-                                             std::to_string(above.idx()) + " of face " +
-                                             std::to_string(g.idx()) + " is " + number(height) +
-                                             " above the plane of face " + std::to_string(f.idx()) +
-                                             " (tolerance " + number(tolerance) + ")");
+      const int from = m.from(h), to = m.to(h);
+      const int* corners = cycles.corners(g);
+      for (int k = 0; k < cycles.degree(g); ++k) {
+        const int v = corners[k];
+        if (v == from || v == to) continue;
+        const double above = height(plane, m.points[v]);
+        if (!(above <= tolerance))
+          return fail(Verdict::not_convex,
+                      "edge " + std::to_string(e) + " (vertices " + vertex_pair(m, e) +
+                          ") is reflex: vertex " + std::to_string(v) + " of face " +
+                          std::to_string(g) + " is " + number(above) + " above the plane of face " +
+                          std::to_string(f) + " (tolerance " + number(tolerance) + ")");
+      }
     }
   }
   return {};
@@ -348,11 +426,13 @@ Finding planar_and_convex(const Mesh& mesh, double relative_tolerance, Geometry&
 // The full rule; stops at the first problem. An inverted mesh is reported as such
 // before the geometric checks (which assume outward normals).
 Finding convex_polyhedron(const Mesh& mesh, double relative_tolerance) {
-  if (Finding found = closed_manifold(mesh); found.verdict != Verdict::ok) return found;
+  const MeshView m(mesh);
+  if (Finding found = closed_manifold(m); found.verdict != Verdict::ok) return found;
   Geometry geometry;
-  if (Finding found = nondegenerate(mesh, geometry); found.verdict != Verdict::ok) return found;
-  if (Finding found = outward(mesh, geometry.extent); found.verdict != Verdict::ok) return found;
-  return planar_and_convex(mesh, relative_tolerance, geometry);
+  if (Finding found = nondegenerate(m, relative_tolerance, geometry); found.verdict != Verdict::ok)
+    return found;
+  if (Finding found = outward(geometry.volumes); found.verdict != Verdict::ok) return found;
+  return planar_and_convex(m, relative_tolerance, geometry);
 }
 
 CheckResult to_result(Finding found) { return {std::move(found.problem), {}}; }
@@ -374,15 +454,21 @@ Mesh rebuilt(const Mesh& mesh, bool flip) {
 
 }  // namespace
 
-CheckResult check_closed_manifold(const Mesh& mesh) { return to_result(closed_manifold(mesh)); }
-
-CheckResult check_outward_oriented(const Mesh& mesh) {
-  if (Finding found = closed_manifold(mesh); found.verdict != Verdict::ok)
-    return {"orientation is undefined: " + found.problem, {}};
-  return to_result(outward(mesh));
+CheckResult check_closed_manifold(const Mesh& mesh) {
+  return to_result(closed_manifold(MeshView(mesh)));
 }
 
-CheckResult check_nondegenerate(const Mesh& mesh) { return to_result(nondegenerate(mesh)); }
+CheckResult check_outward_oriented(const Mesh& mesh) {
+  const MeshView m(mesh);
+  if (Finding found = closed_manifold(m); found.verdict != Verdict::ok)
+    return {"orientation is undefined: " + found.problem, {}};
+  return to_result(outward(fan_volumes(m, face_cycles(m), bounding_box(m).centre)));
+}
+
+CheckResult check_nondegenerate(const Mesh& mesh) {
+  Geometry geometry;
+  return to_result(nondegenerate(MeshView(mesh), kPlanarityTolerance, geometry));
+}
 
 CheckResult check_convex_polyhedron(const Mesh& mesh, const ValidationOptions& options) {
   return to_result(convex_polyhedron(mesh, options.planarity_tolerance));
@@ -420,7 +506,8 @@ std::optional<PreparedMesh> check_operand(const Mesh& mesh, std::string_view nam
 }  // namespace detail
 
 double signed_volume(const Mesh& mesh) {
-  return fan_volumes(mesh, bounding_box(mesh).centre).first;
+  const MeshView m(mesh);
+  return fan_volumes(m, face_cycles(m), bounding_box(m).centre).total / 6;
 }
 
 }  // namespace morph
