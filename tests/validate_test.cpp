@@ -200,6 +200,28 @@ TEST_CASE("validate: non-finite coordinates are rejected") {
   CHECK(contains(result.problem, "vertex 3 has a coordinate that is not finite"));
 }
 
+TEST_CASE("validate: sizes outside [kMinSize, kMaxSize] are rejected with one clear message") {
+  for (double scale : {1e-100, 1e-200, 1e100, 1e200}) {
+    CAPTURE(scale);
+    auto points = cube_points();
+    for (auto& p : points) p *= scale;
+    const Mesh mesh = mesh_of(points, kCubeQuads);
+    const auto result = morph::check_convex_polyhedron(mesh);
+    REQUIRE_FALSE(result.ok());
+    CHECK(contains(result.problem, "is outside the supported range [1e-80, 1e+80]"));
+    check_rejected_as_invalid(mesh, "A: the mesh's size (bounding-box diagonal");
+  }
+  for (double scale : {1e-70, 1e70}) {  // inside: every check still works
+    CAPTURE(scale);
+    auto points = cube_points();
+    for (auto& p : points) p *= scale;
+    CHECK(morph::check_convex_polyhedron(mesh_of(points, kCubeQuads)).ok());
+    CHECK(morph::check_convex_polyhedron(mesh_of(points, cube_triangles())).ok());
+    points[7] *= 0.9;  // pushed inwards: reflex edges
+    CHECK_FALSE(morph::check_convex_polyhedron(mesh_of(points, kCubeQuads)).ok());
+  }
+}
+
 TEST_CASE("validate: two disjoint cubes are not connected") {
   auto points = cube_points();
   for (const auto& p : cube_points({3, 0, 0})) points.push_back(p);

@@ -337,6 +337,10 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
   }
   geometry.extent = bounding_box(m);
   const double diagonal = geometry.extent.diagonal;
+  if (!(diagonal >= kMinSize && diagonal <= kMaxSize))
+    return fail(Verdict::invalid, "the mesh's size (bounding-box diagonal " + number(diagonal) +
+                                      ") is outside the supported range [" + number(kMinSize) + ", " +
+                                      number(kMaxSize) + "]");
   const double tolerance = relative_tolerance * diagonal;
   geometry.cycles = face_cycles(m);
   geometry.planes.resize(m.n_faces);

@@ -5,7 +5,7 @@
 // The convexity rule, stated once:
 //   1. the mesh is non-empty, closed (every edge has two faces), 2-manifold (edges and
 //      vertices), connected, of genus 0, and every face has >= 3 distinct vertices and
-//      non-zero area;
+//      non-zero area; its size (bounding-box diagonal) lies in [kMinSize, kMaxSize];
 //   2. faces are consistently oriented with outward normals (positive volume);
 //   3. every face is planar to within kPlanarityTolerance: each of its vertices lies
 //      within kPlanarityTolerance * D of the plane through the face's centroid with the
@@ -33,6 +33,11 @@ namespace morph {
 /// visible feature.
 inline constexpr double kPlanarityTolerance = 1e-9;
 
+/// The sizes (bounding-box diagonals) of meshes libmorph accepts: volumes and areas,
+/// computed in doubles by the checks, neither underflow nor overflow within this range.
+inline constexpr double kMinSize = 1e-80;
+inline constexpr double kMaxSize = 1e80;
+
 struct ValidationOptions {
   double planarity_tolerance = kPlanarityTolerance;  // relative to the bbox diagonal
   bool fix_inverted = true;  // a closed mesh oriented inwards everywhere is flipped (with a note)
@@ -51,7 +56,8 @@ CheckResult check_closed_manifold(const Mesh& mesh);
 /// Faces consistently oriented, and outward (positive signed volume).
 CheckResult check_outward_oriented(const Mesh& mesh);
 
-/// Faces with >= 3 distinct vertices and non-zero area.
+/// Faces with >= 3 distinct vertices and non-zero area, finite coordinates, and a size in
+/// [kMinSize, kMaxSize].
 CheckResult check_nondegenerate(const Mesh& mesh);
 
 /// The full rule above (1-4).
