@@ -69,25 +69,28 @@ std::optional<Connectivity> connect(int num_points, const Soup& soup) {
   }
   // Outgoing corners of each vertex (counting sort).
   std::vector<int> out_begin(num_points + 1, 0), out(nc);
-  for (int c = 0; c < nc; ++c) ++out_begin[soup.vertex[c] + 1];
-  std::partial_sum(out_begin.begin(), out_begin.end(), out_begin.begin());
-  {
-    std::vector<int> fill(out_begin.begin(), out_begin.end() - 1);
-    for (int c = 0; c < nc; ++c) out[fill[soup.vertex[c]]++] = c;
-  }
+  for (int c = 0; c < nc; ++c) ++out_begin[soup.vertex[c]];
+  std::partial_sum(out_begin.begin(), out_begin.end(), out_begin.begin());  // ends, until filled
+  for (int c = nc - 1; c >= 0; --c) out[--out_begin[soup.vertex[c]]] = c;
   auto target = [&](int c) { return soup.vertex[k.next[c]]; };
+  // Each corner d ending at v (u -> v) precedes one leaving v; its twin is the edge
+  // v -> u, looked up by its end while the edges leaving v are marked.
+  std::vector<int> edge_to(num_points, -1);
   for (int v = 0; v < num_points; ++v) {
     for (int i = out_begin[v]; i < out_begin[v + 1]; ++i) {
-      const int c = out[i], w = target(c);
-      for (int j = i + 1; j < out_begin[v + 1]; ++j)
-        if (target(out[j]) == w) return std::nullopt;  // v -> w twice
-      for (int j = out_begin[w]; j < out_begin[w + 1]; ++j)
-        if (target(out[j]) == v) k.twin[c] = out[j];
-      if (k.twin[c] < 0) return std::nullopt;  // v -> w has no opposite edge
+      int& e = edge_to[target(out[i])];
+      if (e >= 0) return std::nullopt;  // v -> w twice
+      e = out[i];
     }
-  }
-  // One fan per vertex: turning from an outgoing edge to the next reaches them all.
-  for (int v = 0; v < num_points; ++v) {
+    for (int i = out_begin[v]; i < out_begin[v + 1]; ++i) {
+      const int d = k.prev[out[i]];
+      const int t = edge_to[soup.vertex[d]];
+      if (t < 0) return std::nullopt;  // u -> v has no opposite edge
+      k.twin[d] = t;
+    }
+    for (int i = out_begin[v]; i < out_begin[v + 1]; ++i) edge_to[target(out[i])] = -1;
+    // One fan per vertex: turning from an outgoing edge to the next reaches them all
+    // (the twins it turns over, of edges ending at v, are all known now).
     const int n = out_begin[v + 1] - out_begin[v];
     if (n == 0) continue;
     const int start = out[out_begin[v]];
@@ -114,14 +117,16 @@ FacetGeometry geometry(const std::vector<V3<double>>& points, const Soup& soup, 
   const int b = soup.begin[f], d = soup.degree(f);
   const V3<double>& origin = points[soup.vertex[b]];
   V3<double> sum{0, 0, 0}, centroid{0, 0, 0};
+  double longest_squared = 0;  // the root is monotonic: the root of the maximum is the maximum root
   for (int k = 0; k < d; ++k) {
     const V3<double> p = points[soup.vertex[b + k]] - origin;
     const V3<double> q = points[soup.vertex[b + (k + 1 == d ? 0 : k + 1)]] - origin;
     sum = sum + cross(p, q);  // Newell's normal (twice the vector area)
     const V3<double> e = q - p;
-    g.longest_edge = std::max(g.longest_edge, std::sqrt(dot(e, e)));
+    longest_squared = std::max(longest_squared, dot(e, e));
     centroid = centroid + p;
   }
+  g.longest_edge = std::sqrt(longest_squared);
   centroid = {origin.x + centroid.x / d, origin.y + centroid.y / d, origin.z + centroid.z / d};
   g.twice_area = std::sqrt(dot(sum, sum));
   if (g.twice_area > 0) {
@@ -191,12 +196,15 @@ bool convex_polygon(const std::vector<V3<double>>& points, const std::vector<int
   const int d = static_cast<int>(cycle.size());
   for (int i = 0; i < d; ++i) {
     const auto& a = points[cycle[i]];
-    const auto& b = points[cycle[(i + 1) % d]];
-    const auto& c = points[cycle[(i + 2) % d]];
+    const auto& b = points[cycle[i + 1 < d ? i + 1 : i + 1 - d]];
+    const auto& c = points[cycle[i + 2 < d ? i + 2 : i + 2 - d]];
+    // Height of b over the chord a-c times the chord's length, positive when the corner
+    // at b is convex; a convex corner (most) needs no division.
+    const double scaled_height = dot(cross(b - a, c - b), normal);
+    if (scaled_height >= 0) continue;
     const V3<double> ac = c - a;
     const double base = std::sqrt(dot(ac, ac));
-    // Height of b over the chord a-c, positive when the corner at b is convex.
-    if (base > 0 && dot(cross(b - a, c - b), normal) / base < -limit) return false;
+    if (base > 0 && scaled_height / base < -limit) return false;
   }
   return true;
 }
