@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <optional>
@@ -319,21 +320,29 @@ Mesh build(const std::vector<V3<double>>& points, const Soup& soup, const Connec
   std::vector<char> used(points.size(), 0);
   for (int v : soup.vertex) used[v] = 1;
   int num_used = 0;
-  for (char u : used) num_used += u;
-  mesh.reserve(num_used, nc / 2, soup.size());
   for (std::size_t v = 0; v < points.size(); ++v)
-    if (used[v]) handle[v] = mesh.add_vertex(Point(points[v].x, points[v].y, points[v].z));
+    if (used[v]) handle[v] = Mesh::VertexHandle(num_used++);
+  int num_edges = 0;
+  for (int c = 0; c < nc; ++c) num_edges += k.twin[c] >= c;
+  // Every element at once: OpenMesh grows each of its property arrays per added element.
+  // The elements are numbered as add_vertex, new_edge and new_face would number them.
+  mesh.resize(num_used, num_edges, soup.size());
+  for (std::size_t v = 0; v < points.size(); ++v)
+    if (used[v]) mesh.set_point(handle[v], Point(points[v].x, points[v].y, points[v].z));
   std::vector<Mesh::HalfedgeHandle> he(nc);
+  int edge = 0;
   for (int c = 0; c < nc; ++c) {
     const int t = k.twin[c];
     if (t < c) {
       he[c] = mesh.opposite_halfedge_handle(he[t]);
     } else {
-      he[c] = mesh.new_edge(handle[soup.vertex[c]], handle[soup.vertex[k.next[c]]]);
+      he[c] = mesh.halfedge_handle(Mesh::EdgeHandle(edge++), 0);
+      mesh.set_vertex_handle(he[c], handle[soup.vertex[k.next[c]]]);
+      mesh.set_vertex_handle(mesh.opposite_halfedge_handle(he[c]), handle[soup.vertex[c]]);
     }
   }
   for (int f = 0; f < soup.size(); ++f) {
-    const auto fh = mesh.new_face();
+    const Mesh::FaceHandle fh(f);
     const int b = soup.begin[f], e = soup.begin[f + 1];
     for (int c = b; c < e; ++c) {
       mesh.set_face_handle(he[c], fh);
@@ -431,9 +440,15 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
     while (rep[x] != x) x = rep[x] = rep[rep[x]];
     return x;
   };
+  // Squared distances above `far` are beyond `limit` whatever the rounding of its square
+  // (a margin of 2), so most pairs need no square root.
+  const double limit_squared = limit * limit;
+  const double far = limit_squared >= std::numeric_limits<double>::min() ? 2 * limit_squared
+                                                                          : std::numeric_limits<double>::infinity();
   auto merge_if_close = [&](int u, int w) {
     const V3<double> d = points[u] - points[w];
-    if (std::sqrt(dot(d, d)) <= limit) {
+    const double distance_squared = dot(d, d);
+    if (distance_squared <= far && std::sqrt(distance_squared) <= limit) {
       const int a = find(u), b = find(w);
       if (a != b) rep[std::max(a, b)] = std::min(a, b);
     }
@@ -452,6 +467,7 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
   soup.source.reserve(nf);
   bool repeated = false;
   std::vector<int> cycle;
+  std::vector<int> last_facet(n, -1);  // the last facet a point was seen in, to find repeats
   for (int f = 0; f < nf; ++f) {
     cycle.clear();
     for (int c = face_begin[f]; c < face_begin[f + 1]; ++c) {
@@ -460,8 +476,10 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
     }
     while (cycle.size() > 1 && cycle.front() == cycle.back()) cycle.pop_back();
     if (cycle.size() < 3) continue;  // collapsed onto an edge or a point: its neighbours meet
-    for (std::size_t i = 0; i < cycle.size() && !repeated; ++i)
-      for (std::size_t j = i + 1; j < cycle.size() && !repeated; ++j) repeated = cycle[i] == cycle[j];
+    for (std::size_t i = 0; i < cycle.size() && !repeated; ++i) {
+      repeated = last_facet[cycle[i]] == f;
+      last_facet[cycle[i]] = f;
+    }
     soup.add(cycle, f);
   }
   std::optional<std::pair<Soup, Connectivity>> result;
