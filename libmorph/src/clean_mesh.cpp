@@ -227,9 +227,11 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
         for (int c = soup.begin[f]; c < soup.begin[f + 1] && alone; ++c) alone = groups.of[k.face[k.twin[c]]] != f;
         if (alone) return false;
       }
-  const auto group = [&](int c) { return groups.of[k.face[c]]; };
-  // Vertices keep their place when at least three groups meet there.
   const int nc = static_cast<int>(soup.vertex.size());
+  std::vector<int> corner_group(nc);  // looked up several times per corner below
+  for (int c = 0; c < nc; ++c) corner_group[c] = groups.of[k.face[c]];
+  const auto group = [&](int c) { return corner_group[c]; };
+  // Vertices keep their place when at least three groups meet there.
   std::vector<char> keep(points.size(), 0), seen(points.size(), 0);
   bool dropped = false;
   for (int c = 0; c < nc; ++c) {
@@ -254,6 +256,9 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
   // The boundary of each group, walked from its first boundary corner.
   std::vector<char> walked(nc, 0);
   Soup out;
+  out.begin.reserve(nf + 1);
+  out.vertex.reserve(nc);
+  out.source.reserve(nf);
   std::vector<int> cycle;
   std::vector<int> largest(nf, -1);  // the group's largest facet gives its source
   for (int f = 0; f < nf; ++f) {

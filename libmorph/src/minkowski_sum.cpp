@@ -229,9 +229,10 @@ LabelledMesh sum_mesh(const Polytope& A, const Polytope& B, const SumFacets& fac
     }
   });
   std::vector<int> source;
-  LabelledMesh out;
-  out.mesh = clean_mesh(points, facets.face_begin, corners, &source);
+  // Initialised in place: OpenMesh meshes have no move assignment, only a deep copy.
+  LabelledMesh out{clean_mesh(points, facets.face_begin, corners, &source), {}};
   // A face with no source (a triangle of the hull fallback that no facet owns) has no origin.
+  out.origins.reserve(source.size());
   for (int f : source) out.origins.push_back(f >= 0 ? facets.origins[f] : FacetOrigin{FacetKind::edge, {}, {}});
   return out;
 }
