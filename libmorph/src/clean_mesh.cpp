@@ -298,7 +298,8 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
 
 /// Passes 2 and 3, then connectivity of the result. Strict: nothing when the soup is not
 /// a closed manifold or merging fails; else (hull triangles) an unmerged soup is kept.
-std::optional<std::pair<Soup, Connectivity>> simplify(const std::vector<V3<double>>& points, Soup soup,
+/// `soup` is moved into the result when it is the result, and left alone otherwise.
+std::optional<std::pair<Soup, Connectivity>> simplify(const std::vector<V3<double>>& points, Soup& soup,
                                                       double limit, bool strict) {
   std::optional<Connectivity> k = connect(static_cast<int>(points.size()), soup);
   if (!k) return std::nullopt;
@@ -309,6 +310,7 @@ std::optional<std::pair<Soup, Connectivity>> simplify(const std::vector<V3<doubl
     return std::make_pair(std::move(soup), std::move(*k));
   }
   if (!changed) return std::make_pair(std::move(soup), std::move(*k));
+  if (strict) k.reset();  // no use for it any more: its memory serves the next one
   std::optional<Connectivity> km = connect(static_cast<int>(points.size()), merged);
   if (km) return std::make_pair(std::move(merged), std::move(*km));
   if (strict) return std::nullopt;
@@ -489,10 +491,14 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
   }
   std::optional<std::pair<Soup, Connectivity>> result;
   if (!repeated) result = simplify(points, soup, limit, true);
-  if (!result) result = simplify(points, hull_triangles(points, soup), limit, false);
+  if (!result) {
+    Soup hull = hull_triangles(points, soup);
+    result = simplify(points, hull, limit, false);
+  }
   if (!result) throw error("internal error: the hull of a result could not be joined into a mesh");
-  if (source) *source = result->first.source;
-  return build(points, result->first, result->second);
+  Mesh mesh = build(points, result->first, result->second);
+  if (source) *source = std::move(result->first.source);
+  return mesh;
 }
 
 }  // namespace morph::detail
