@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <functional>
 #include <set>
 #include <sstream>
 #include <string>
@@ -450,4 +451,25 @@ TEST_CASE("fims: output is identical for any thread count") {
   }
   CHECK(clean_mesh_problem(one.mesh, kRoundedClean).empty());
   CHECK(origins_problem(one, A, B, true).empty());
+}
+
+TEST_CASE("fims: result vertices are numbered in the order of their pairs (vertex of A, vertex of B)") {
+  // Grid coordinates: every vertex sum is exact, so each result vertex names its pair
+  // (a vertex of a sum of convex bodies is the sum of exactly one pair of vertices).
+  for (std::uint64_t s = 1; s <= 3; ++s) {
+    CAPTURE(s);
+    const Mesh A = random_grid_polytope(30, 40 + s);
+    const Mesh B = random_grid_polytope(12, 50 + s);
+    const std::vector<Point> pa = positions(A), pb = positions(B);
+    std::vector<std::pair<int, int>> pairs;
+    for (const Point& p : positions(minkowski_sum(A, B).mesh)) {
+      std::vector<std::pair<int, int>> found;
+      for (int i = 0; i < static_cast<int>(pa.size()); ++i)
+        for (int j = 0; j < static_cast<int>(pb.size()); ++j)
+          if (pa[i] + pb[j] == p) found.emplace_back(i, j);
+      REQUIRE(found.size() == 1);
+      pairs.push_back(found[0]);
+    }
+    CHECK(std::adjacent_find(pairs.begin(), pairs.end(), std::greater_equal<>()) == pairs.end());
+  }
 }

@@ -11,15 +11,15 @@
 // When the facets no longer describe a closed manifold after pass 1 or a merged polygon
 // is not convex to within the feature size, the mesh is rebuilt instead from the convex
 // hull of the points (exact predicates), whose triangles go through passes 2 and 3.
-#include <morph/error.h>
-
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/convex_hull_3.h>
+#include <morph/error.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <optional>
@@ -69,25 +69,28 @@ std::optional<Connectivity> connect(int num_points, const Soup& soup) {
   }
   // Outgoing corners of each vertex (counting sort).
   std::vector<int> out_begin(num_points + 1, 0), out(nc);
-  for (int c = 0; c < nc; ++c) ++out_begin[soup.vertex[c] + 1];
-  std::partial_sum(out_begin.begin(), out_begin.end(), out_begin.begin());
-  {
-    std::vector<int> fill(out_begin.begin(), out_begin.end() - 1);
-    for (int c = 0; c < nc; ++c) out[fill[soup.vertex[c]]++] = c;
-  }
+  for (int c = 0; c < nc; ++c) ++out_begin[soup.vertex[c]];
+  std::partial_sum(out_begin.begin(), out_begin.end(), out_begin.begin());  // ends, until filled
+  for (int c = nc - 1; c >= 0; --c) out[--out_begin[soup.vertex[c]]] = c;
   auto target = [&](int c) { return soup.vertex[k.next[c]]; };
+  // Each corner d ending at v (u -> v) precedes one leaving v; its twin is the edge
+  // v -> u, looked up by its end while the edges leaving v are marked.
+  std::vector<int> edge_to(num_points, -1);
   for (int v = 0; v < num_points; ++v) {
     for (int i = out_begin[v]; i < out_begin[v + 1]; ++i) {
-      const int c = out[i], w = target(c);
-      for (int j = i + 1; j < out_begin[v + 1]; ++j)
-        if (target(out[j]) == w) return std::nullopt;  // v -> w twice
-      for (int j = out_begin[w]; j < out_begin[w + 1]; ++j)
-        if (target(out[j]) == v) k.twin[c] = out[j];
-      if (k.twin[c] < 0) return std::nullopt;  // v -> w has no opposite edge
+      int& e = edge_to[target(out[i])];
+      if (e >= 0) return std::nullopt;  // v -> w twice
+      e = out[i];
     }
-  }
-  // One fan per vertex: turning from an outgoing edge to the next reaches them all.
-  for (int v = 0; v < num_points; ++v) {
+    for (int i = out_begin[v]; i < out_begin[v + 1]; ++i) {
+      const int d = k.prev[out[i]];
+      const int t = edge_to[soup.vertex[d]];
+      if (t < 0) return std::nullopt;  // u -> v has no opposite edge
+      k.twin[d] = t;
+    }
+    for (int i = out_begin[v]; i < out_begin[v + 1]; ++i) edge_to[target(out[i])] = -1;
+    // One fan per vertex: turning from an outgoing edge to the next reaches them all
+    // (the twins it turns over, of edges ending at v, are all known now).
     const int n = out_begin[v + 1] - out_begin[v];
     if (n == 0) continue;
     const int start = out[out_begin[v]];
@@ -114,14 +117,16 @@ FacetGeometry geometry(const std::vector<V3<double>>& points, const Soup& soup, 
   const int b = soup.begin[f], d = soup.degree(f);
   const V3<double>& origin = points[soup.vertex[b]];
   V3<double> sum{0, 0, 0}, centroid{0, 0, 0};
+  double longest_squared = 0;  // the root is monotonic: the root of the maximum is the maximum root
   for (int k = 0; k < d; ++k) {
     const V3<double> p = points[soup.vertex[b + k]] - origin;
     const V3<double> q = points[soup.vertex[b + (k + 1 == d ? 0 : k + 1)]] - origin;
     sum = sum + cross(p, q);  // Newell's normal (twice the vector area)
     const V3<double> e = q - p;
-    g.longest_edge = std::max(g.longest_edge, std::sqrt(dot(e, e)));
+    longest_squared = std::max(longest_squared, dot(e, e));
     centroid = centroid + p;
   }
+  g.longest_edge = std::sqrt(longest_squared);
   centroid = {origin.x + centroid.x / d, origin.y + centroid.y / d, origin.z + centroid.z / d};
   g.twice_area = std::sqrt(dot(sum, sum));
   if (g.twice_area > 0) {
@@ -131,7 +136,9 @@ FacetGeometry geometry(const std::vector<V3<double>>& points, const Soup& soup, 
   return g;
 }
 
-bool is_thin(const FacetGeometry& g, double limit) { return g.twice_area <= 2 * limit * g.longest_edge; }
+bool is_thin(const FacetGeometry& g, double limit) {
+  return g.twice_area <= 2 * limit * g.longest_edge;
+}
 
 struct Groups {
   std::vector<int> of;  // group (its lowest facet index) of each facet
@@ -142,8 +149,8 @@ struct Groups {
 /// when all its vertices lie within `limit` of the plane of the group's largest facet,
 /// or the group joins it the other way round. Needles (facets thinner than `limit`) have
 /// no reliable plane of their own; they join a neighbour whose plane holds them.
-Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup, const Connectivity& k,
-                      const std::vector<FacetGeometry>& geo, double limit) {
+Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
+                      const Connectivity& k, const std::vector<FacetGeometry>& geo, double limit) {
   const int nf = soup.size();
   std::vector<int> parent(nf), reference(nf), next_member(nf, -1), last_member(nf);
   std::iota(parent.begin(), parent.end(), 0);
@@ -186,17 +193,20 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup, c
 
 /// Corner (interior angle) test of a polygon against its plane's normal: no corner is
 /// reflex by more than `limit`.
-bool convex_polygon(const std::vector<V3<double>>& points, const std::vector<int>& cycle, const V3<double>& normal,
-                    double limit) {
+bool convex_polygon(const std::vector<V3<double>>& points, const std::vector<int>& cycle,
+                    const V3<double>& normal, double limit) {
   const int d = static_cast<int>(cycle.size());
   for (int i = 0; i < d; ++i) {
     const auto& a = points[cycle[i]];
-    const auto& b = points[cycle[(i + 1) % d]];
-    const auto& c = points[cycle[(i + 2) % d]];
+    const auto& b = points[cycle[i + 1 < d ? i + 1 : i + 1 - d]];
+    const auto& c = points[cycle[i + 2 < d ? i + 2 : i + 2 - d]];
+    // Height of b over the chord a-c times the chord's length, positive when the corner
+    // at b is convex; a convex corner (most) needs no division.
+    const double scaled_height = dot(cross(b - a, c - b), normal);
+    if (scaled_height >= 0) continue;
     const V3<double> ac = c - a;
     const double base = std::sqrt(dot(ac, ac));
-    // Height of b over the chord a-c, positive when the corner at b is convex.
-    if (base > 0 && dot(cross(b - a, c - b), normal) / base < -limit) return false;
+    if (base > 0 && scaled_height / base < -limit) return false;
   }
   return true;
 }
@@ -205,8 +215,8 @@ bool convex_polygon(const std::vector<V3<double>>& points, const std::vector<int
 /// `out` (`changed` tells whether any merged; `out` is untouched if not). False when a
 /// group is not one disc or its polygon is not convex; `strict`: also when a needle finds
 /// no group.
-bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, const Connectivity& k, double limit,
-                    bool strict, Soup& merged, bool& changed) {
+bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, const Connectivity& k,
+                    double limit, bool strict, Soup& merged, bool& changed) {
   const int nf = soup.size();
   std::vector<FacetGeometry> geo(nf);
   for (int f = 0; f < nf; ++f) geo[f] = geometry(points, soup, f);
@@ -215,12 +225,15 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
     for (int f = 0; f < nf; ++f)
       if (is_thin(geo[f], limit) && groups.of[f] == f) {
         bool alone = true;
-        for (int c = soup.begin[f]; c < soup.begin[f + 1] && alone; ++c) alone = groups.of[k.face[k.twin[c]]] != f;
+        for (int c = soup.begin[f]; c < soup.begin[f + 1] && alone; ++c)
+          alone = groups.of[k.face[k.twin[c]]] != f;
         if (alone) return false;
       }
-  const auto group = [&](int c) { return groups.of[k.face[c]]; };
-  // Vertices keep their place when at least three groups meet there.
   const int nc = static_cast<int>(soup.vertex.size());
+  std::vector<int> corner_group(nc);  // looked up several times per corner below
+  for (int c = 0; c < nc; ++c) corner_group[c] = groups.of[k.face[c]];
+  const auto group = [&](int c) { return corner_group[c]; };
+  // Vertices keep their place when at least three groups meet there.
   std::vector<char> keep(points.size(), 0), seen(points.size(), 0);
   bool dropped = false;
   for (int c = 0; c < nc; ++c) {
@@ -231,8 +244,10 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
     do {
       const int g = group(e);
       if (g != g1 && g != g2) {
-        if (g1 < 0) g1 = g;
-        else if (g2 < 0) g2 = g;
+        if (g1 < 0)
+          g1 = g;
+        else if (g2 < 0)
+          g2 = g;
         ++distinct;
       }
       e = k.twin[k.prev[e]];
@@ -245,6 +260,9 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
   // The boundary of each group, walked from its first boundary corner.
   std::vector<char> walked(nc, 0);
   Soup out;
+  out.begin.reserve(nf + 1);
+  out.vertex.reserve(nc);
+  out.source.reserve(nf);
   std::vector<int> cycle;
   std::vector<int> largest(nf, -1);  // the group's largest facet gives its source
   for (int f = 0; f < nf; ++f) {
@@ -272,7 +290,8 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
       c = n;
       if (++steps > nc) return false;
     } while (c != start);
-    if (cycle.size() < 3 || !convex_polygon(points, cycle, geo[largest[g]].normal, limit)) return false;
+    if (cycle.size() < 3 || !convex_polygon(points, cycle, geo[largest[g]].normal, limit))
+      return false;
     out.add(cycle, soup.source[largest[g]]);
   }
   // A group with a second boundary cycle is not a disc.
@@ -284,8 +303,9 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
 
 /// Passes 2 and 3, then connectivity of the result. Strict: nothing when the soup is not
 /// a closed manifold or merging fails; else (hull triangles) an unmerged soup is kept.
-std::optional<std::pair<Soup, Connectivity>> simplify(const std::vector<V3<double>>& points, Soup soup,
-                                                      double limit, bool strict) {
+/// `soup` is moved into the result when it is the result, and left alone otherwise.
+std::optional<std::pair<Soup, Connectivity>> simplify(const std::vector<V3<double>>& points,
+                                                      Soup& soup, double limit, bool strict) {
   std::optional<Connectivity> k = connect(static_cast<int>(points.size()), soup);
   if (!k) return std::nullopt;
   Soup merged;
@@ -295,6 +315,7 @@ std::optional<std::pair<Soup, Connectivity>> simplify(const std::vector<V3<doubl
     return std::make_pair(std::move(soup), std::move(*k));
   }
   if (!changed) return std::make_pair(std::move(soup), std::move(*k));
+  if (strict) k.reset();  // no use for it any more: its memory serves the next one
   std::optional<Connectivity> km = connect(static_cast<int>(points.size()), merged);
   if (km) return std::make_pair(std::move(merged), std::move(*km));
   if (strict) return std::nullopt;
@@ -311,21 +332,29 @@ Mesh build(const std::vector<V3<double>>& points, const Soup& soup, const Connec
   std::vector<char> used(points.size(), 0);
   for (int v : soup.vertex) used[v] = 1;
   int num_used = 0;
-  for (char u : used) num_used += u;
-  mesh.reserve(num_used, nc / 2, soup.size());
   for (std::size_t v = 0; v < points.size(); ++v)
-    if (used[v]) handle[v] = mesh.add_vertex(Point(points[v].x, points[v].y, points[v].z));
+    if (used[v]) handle[v] = Mesh::VertexHandle(num_used++);
+  int num_edges = 0;
+  for (int c = 0; c < nc; ++c) num_edges += k.twin[c] >= c;
+  // Every element at once: OpenMesh grows each of its property arrays per added element.
+  // The elements are numbered as add_vertex, new_edge and new_face would number them.
+  mesh.resize(num_used, num_edges, soup.size());
+  for (std::size_t v = 0; v < points.size(); ++v)
+    if (used[v]) mesh.set_point(handle[v], Point(points[v].x, points[v].y, points[v].z));
   std::vector<Mesh::HalfedgeHandle> he(nc);
+  int edge = 0;
   for (int c = 0; c < nc; ++c) {
     const int t = k.twin[c];
     if (t < c) {
       he[c] = mesh.opposite_halfedge_handle(he[t]);
     } else {
-      he[c] = mesh.new_edge(handle[soup.vertex[c]], handle[soup.vertex[k.next[c]]]);
+      he[c] = mesh.halfedge_handle(Mesh::EdgeHandle(edge++), 0);
+      mesh.set_vertex_handle(he[c], handle[soup.vertex[k.next[c]]]);
+      mesh.set_vertex_handle(mesh.opposite_halfedge_handle(he[c]), handle[soup.vertex[c]]);
     }
   }
   for (int f = 0; f < soup.size(); ++f) {
-    const auto fh = mesh.new_face();
+    const Mesh::FaceHandle fh(f);
     const int b = soup.begin[f], e = soup.begin[f + 1];
     for (int c = b; c < e; ++c) {
       mesh.set_face_handle(he[c], fh);
@@ -347,7 +376,8 @@ Soup hull_triangles(const std::vector<V3<double>>& points, const Soup& facets) {
   const int nf = facets.size();
   std::map<int, std::vector<int>> facets_of;  // point -> facets that have it as a corner
   for (int f = 0; f < nf; ++f)
-    for (int c = facets.begin[f]; c < facets.begin[f + 1]; ++c) facets_of[facets.vertex[c]].push_back(f);
+    for (int c = facets.begin[f]; c < facets.begin[f + 1]; ++c)
+      facets_of[facets.vertex[c]].push_back(f);
   std::vector<Kernel::Point_3> pts;
   std::map<Kernel::Point_3, int> point_of;
   for (auto& [v, fs] : facets_of) {
@@ -363,7 +393,9 @@ Soup hull_triangles(const std::vector<V3<double>>& points, const Soup& facets) {
   for (int f = 0; f < nf; ++f) {
     V3<double> sum{0, 0, 0};
     for (int c = facets.begin[f]; c < facets.begin[f + 1]; ++c)
-      sum = sum + cross(points[facets.vertex[c]], points[facets.vertex[c + 1 == facets.begin[f + 1] ? facets.begin[f] : c + 1]]);
+      sum = sum +
+            cross(points[facets.vertex[c]],
+                  points[facets.vertex[c + 1 == facets.begin[f + 1] ? facets.begin[f] : c + 1]]);
     const double len = std::sqrt(dot(sum, sum));
     facet_normal[f] = len > 0 ? V3<double>{sum.x / len, sum.y / len, sum.z / len} : sum;
   }
@@ -372,13 +404,15 @@ Soup hull_triangles(const std::vector<V3<double>>& points, const Soup& facets) {
   std::vector<std::array<int, 4>> tris;  // three points, source
   for (auto t : hull.faces()) {
     std::vector<int> tri;
-    for (auto v : CGAL::vertices_around_face(hull.halfedge(t), hull)) tri.push_back(point_of.at(hull.point(v)));
+    for (auto v : CGAL::vertices_around_face(hull.halfedge(t), hull))
+      tri.push_back(point_of.at(hull.point(v)));
     std::rotate(tri.begin(), std::min_element(tri.begin(), tri.end()), tri.end());
     std::vector<int> common = facets_of.at(tri[0]), all = common;
     for (int k = 1; k < 3; ++k) {
       const auto& fs = facets_of.at(tri[k]);
       std::vector<int> both;
-      std::set_intersection(common.begin(), common.end(), fs.begin(), fs.end(), std::back_inserter(both));
+      std::set_intersection(common.begin(), common.end(), fs.begin(), fs.end(),
+                            std::back_inserter(both));
       common = std::move(both);
       all.insert(all.end(), fs.begin(), fs.end());
     }
@@ -423,9 +457,16 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
     while (rep[x] != x) x = rep[x] = rep[rep[x]];
     return x;
   };
+  // Squared distances above `far` are beyond `limit` whatever the rounding of its square
+  // (a margin of 2), so most pairs need no square root.
+  const double limit_squared = limit * limit;
+  const double far = limit_squared >= std::numeric_limits<double>::min()
+                         ? 2 * limit_squared
+                         : std::numeric_limits<double>::infinity();
   auto merge_if_close = [&](int u, int w) {
     const V3<double> d = points[u] - points[w];
-    if (std::sqrt(dot(d, d)) <= limit) {
+    const double distance_squared = dot(d, d);
+    if (distance_squared <= far && std::sqrt(distance_squared) <= limit) {
       const int a = find(u), b = find(w);
       if (a != b) rep[std::max(a, b)] = std::min(a, b);
     }
@@ -444,6 +485,7 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
   soup.source.reserve(nf);
   bool repeated = false;
   std::vector<int> cycle;
+  std::vector<int> last_facet(n, -1);  // the last facet a point was seen in, to find repeats
   for (int f = 0; f < nf; ++f) {
     cycle.clear();
     for (int c = face_begin[f]; c < face_begin[f + 1]; ++c) {
@@ -452,16 +494,22 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
     }
     while (cycle.size() > 1 && cycle.front() == cycle.back()) cycle.pop_back();
     if (cycle.size() < 3) continue;  // collapsed onto an edge or a point: its neighbours meet
-    for (std::size_t i = 0; i < cycle.size() && !repeated; ++i)
-      for (std::size_t j = i + 1; j < cycle.size() && !repeated; ++j) repeated = cycle[i] == cycle[j];
+    for (std::size_t i = 0; i < cycle.size() && !repeated; ++i) {
+      repeated = last_facet[cycle[i]] == f;
+      last_facet[cycle[i]] = f;
+    }
     soup.add(cycle, f);
   }
   std::optional<std::pair<Soup, Connectivity>> result;
   if (!repeated) result = simplify(points, soup, limit, true);
-  if (!result) result = simplify(points, hull_triangles(points, soup), limit, false);
+  if (!result) {
+    Soup hull = hull_triangles(points, soup);
+    result = simplify(points, hull, limit, false);
+  }
   if (!result) throw error("internal error: the hull of a result could not be joined into a mesh");
-  if (source) *source = result->first.source;
-  return build(points, result->first, result->second);
+  Mesh mesh = build(points, result->first, result->second);
+  if (source) *source = std::move(result->first.source);
+  return mesh;
 }
 
 }  // namespace morph::detail

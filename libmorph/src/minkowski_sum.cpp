@@ -2,7 +2,6 @@
 // the two Gauss maps, every decision exact (see gauss_map.h and docs/algorithm.md).
 #include <morph/error.h>
 #include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <cmath>
@@ -205,17 +204,38 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
 namespace {
 
 /// The distinct vertex pairs of the facets, sorted, and each corner's index among them.
-void index_vertices(const SumFacets& facets, std::vector<std::uint64_t>& pairs,
-                    std::vector<int>& corners) {
-  pairs = facets.corners;
-  tbb::parallel_sort(pairs.begin(), pairs.end());
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-  corners.resize(facets.corners.size());
-  parallel_chunks(static_cast<int>(corners.size()), 4096, [&](int begin, int end) {
-    for (int c = begin; c < end; ++c)
-      corners[c] = static_cast<int>(
-          std::lower_bound(pairs.begin(), pairs.end(), facets.corners[c]) - pairs.begin());
-  });
+/// Linear in the number of corners: a counting sort buckets the corners by their vertex
+/// of A, and in each bucket only the few distinct partners in B are sorted.
+void index_vertices(const SumFacets& facets, int num_a, int num_b,
+                    std::vector<std::uint64_t>& pairs, std::vector<int>& corners) {
+  const int nc = static_cast<int>(facets.corners.size());
+  // first[i]..first[i + 1]: the corners at vertex i of A, in `by_a`.
+  std::vector<int> first(num_a + 1, 0), by_a(nc);
+  for (const std::uint64_t key : facets.corners) ++first[pair_first(key)];
+  std::partial_sum(first.begin(), first.end(), first.begin());  // first[i]: end of bucket i
+  for (int c = nc - 1; c >= 0; --c) by_a[--first[pair_first(facets.corners[c])]] = c;
+  std::vector<int> slot(num_b, -1);  // pair index of (i, j) while bucket i is numbered
+  std::vector<int> partners;
+  pairs.clear();
+  corners.resize(nc);
+  for (int i = 0; i < num_a; ++i) {
+    partners.clear();
+    for (int k = first[i]; k < first[i + 1]; ++k) {
+      const int j = pair_second(facets.corners[by_a[k]]);
+      if (slot[j] < 0) {
+        slot[j] = 0;
+        partners.push_back(j);
+      }
+    }
+    std::sort(partners.begin(), partners.end());
+    for (const int j : partners) {
+      slot[j] = static_cast<int>(pairs.size());
+      pairs.push_back(pair_key(i, j));
+    }
+    for (int k = first[i]; k < first[i + 1]; ++k)
+      corners[by_a[k]] = slot[pair_second(facets.corners[by_a[k]])];
+    for (const int j : partners) slot[j] = -1;
+  }
 }
 
 }  // namespace
@@ -223,7 +243,7 @@ void index_vertices(const SumFacets& facets, std::vector<std::uint64_t>& pairs,
 LabelledMesh sum_mesh(const Polytope& A, const Polytope& B, const SumFacets& facets) {
   std::vector<std::uint64_t> pairs;
   std::vector<int> corners;
-  index_vertices(facets, pairs, corners);
+  index_vertices(facets, A.num_vertices(), B.num_vertices(), pairs, corners);
   std::vector<V3<double>> points(pairs.size());
   const bool exact = !A.exact_points.empty() || !B.exact_points.empty();
   parallel_chunks(static_cast<int>(pairs.size()), 1024, [&](int begin, int end) {
@@ -240,9 +260,10 @@ LabelledMesh sum_mesh(const Polytope& A, const Polytope& B, const SumFacets& fac
     }
   });
   std::vector<int> source;
-  LabelledMesh out;
-  out.mesh = clean_mesh(points, facets.face_begin, corners, &source);
+  // Initialised in place: OpenMesh meshes have no move assignment, only a deep copy.
+  LabelledMesh out{clean_mesh(points, facets.face_begin, corners, &source), {}};
   // A face with no source (a triangle of the hull fallback that no facet owns) has no origin.
+  out.origins.reserve(source.size());
   for (int f : source)
     out.origins.push_back(f >= 0 ? facets.origins[f] : FacetOrigin{FacetKind::edge, {}, {}});
   return out;
@@ -251,7 +272,7 @@ LabelledMesh sum_mesh(const Polytope& A, const Polytope& B, const SumFacets& fac
 Polytope sum_polytope(const Polytope& A, const Polytope& B, const SumFacets& facets) {
   std::vector<std::uint64_t> pairs;
   std::vector<int> corners;
-  index_vertices(facets, pairs, corners);
+  index_vertices(facets, A.num_vertices(), B.num_vertices(), pairs, corners);
   std::vector<V3<double>> points(pairs.size());
   std::vector<V3<Exact>> exact(pairs.size());
   for (std::size_t v = 0; v < pairs.size(); ++v) {

@@ -38,7 +38,7 @@ constexpr int kMaxUvSphereSides = 512;  // n of a uvsphere: n^2 faces, 262,144 a
 // Radii, edges: cubes of these stay finite in double, and squared facet areas (~extent^4,
 // as validation computes them) stay above underflow: at 1e-100 every facet had zero area.
 constexpr double kMinExtent = 1e-50;
-constexpr double kMaxExtent = 1e100;
+constexpr double kMaxExtent = 1e50;  // element sizes stay well inside kMaxSize (morph/validate.h)
 
 // Two hull triangles are one face when each lies within this fraction of the
 // circumdiameter of the other's plane: vertices given by irrational formulas (a
@@ -52,7 +52,7 @@ using HullMesh = CGAL::Surface_mesh<Kernel::Point_3>;
 void require_extent(double value, const char* what) {
   if (!(std::isfinite(value) && value >= kMinExtent && value <= kMaxExtent))
     throw input_error(std::string(what) +
-                      " must be a positive finite number between 1e-50 and 1e100, got " +
+                      " must be a positive finite number between 1e-50 and 1e50, got " +
                       std::to_string(value));
 }
 
