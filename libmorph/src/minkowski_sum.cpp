@@ -304,9 +304,8 @@ namespace morph {
 
 LabelledMesh minkowski_sum(const Mesh& A, const Mesh& B, const MinkowskiOptions& options) {
   return detail::run_with_threads(options.threads, [&] {
-    const detail::Polytope pa = detail::make_operand(A, "A");
-    const detail::Polytope pb = detail::make_operand(B, "B");
-    return detail::sum_mesh(pa, pb, detail::fims_facets(pa, pb));
+    const detail::Operands op = detail::make_operands(A, B);
+    return detail::sum_mesh(op.a, op.b, detail::fims_facets(op.a, op.b));
   });
 }
 

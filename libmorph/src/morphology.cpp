@@ -12,13 +12,9 @@ namespace {
 
 using detail::Polytope;
 
-struct Operands {
-  Polytope a, b;
-};
+using detail::Operands;
 
-Operands prepare(const Mesh& A, const Mesh& B) {
-  return {detail::make_operand(A, "A"), detail::make_operand(B, "B")};
-}
+Operands prepare(const Mesh& A, const Mesh& B) { return detail::make_operands(A, B); }
 
 MorphResult empty_result(const detail::MaybePolytope& m) {
   MorphResult r;

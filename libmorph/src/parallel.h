@@ -5,9 +5,11 @@
 #include <tbb/blocked_range.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <exception>
 
 namespace morph::detail {
 
@@ -30,6 +32,30 @@ void parallel_chunks(int n, int grain, const Body& body) {
   }
   tbb::parallel_for(tbb::blocked_range<int>(0, n, grain),
                     [&](const tbb::blocked_range<int>& r) { body(r.begin(), r.end()); });
+}
+
+/// Runs f() and g(), concurrently when there are threads to spare. If both throw, f's
+/// exception is the one rethrown (not whichever came first), so errors are deterministic.
+template <class F, class G>
+void run_both(const F& f, const G& g) {
+  std::exception_ptr ef, eg;
+  tbb::parallel_invoke(
+      [&] {
+        try {
+          f();
+        } catch (...) {
+          ef = std::current_exception();
+        }
+      },
+      [&] {
+        try {
+          g();
+        } catch (...) {
+          eg = std::current_exception();
+        }
+      });
+  if (ef) std::rethrow_exception(ef);
+  if (eg) std::rethrow_exception(eg);
 }
 
 }  // namespace morph::detail

@@ -11,6 +11,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "parallel.h"
 #include "validate_detail.h"
 
 namespace morph::detail {
@@ -753,6 +754,12 @@ Polytope make_polytope(const Mesh& mesh, const char* name, FaceOrder order) {
 Polytope make_operand(const Mesh& mesh, const char* name) {
   const bool inverted = check_operand(mesh, name).has_value();
   return make_polytope(mesh, name, inverted ? FaceOrder::reversed : FaceOrder::as_given);
+}
+
+Operands make_operands(const Mesh& A, const Mesh& B) {
+  Operands op;
+  run_both([&] { op.a = make_operand(A, "A"); }, [&] { op.b = make_operand(B, "B"); });
+  return op;
 }
 
 Mesh to_mesh(const Polytope& p) {

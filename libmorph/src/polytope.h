@@ -215,6 +215,13 @@ Polytope make_polytope(std::vector<V3<double>> points, std::vector<V3<Exact>> ex
 /// not_convex prefixed with `name`, flipping a fully inverted mesh) and builds its polytope.
 Polytope make_operand(const Mesh& mesh, const char* name);
 
+/// make_operand(A, "A") and make_operand(B, "B"), side by side when threads allow; A's
+/// error is reported when both are bad.
+struct Operands {
+  Polytope a, b;
+};
+Operands make_operands(const Mesh& A, const Mesh& B);
+
 /// The mesh of a polytope (its rounded positions), with facets in polytope order.
 Mesh to_mesh(const Polytope& p);
 
