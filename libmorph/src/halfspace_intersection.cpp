@@ -341,17 +341,20 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   }
   // Group triangles whose planes meet in one point (exactly coplanar dual triangles):
   // each group is a vertex of the intersection. Every edge between groups must be
-  // strictly convex: the far plane of each neighbour is strictly satisfied.
+  // strictly convex: the far plane of each neighbour is strictly satisfied. The planes
+  // found through the group's vertex are kept, so each is tested once (exactly, when
+  // the vertex is degenerate: the filter cannot show a zero).
   std::vector<int> group(nt, -1), seed;
   std::vector<HVertex> vertex;
   {
     RoundingGuard guard;
-    std::vector<int> stack;
+    std::vector<int> stack, through;
     for (int t0 = 0; t0 < nt; ++t0) {
       if (group[t0] >= 0) continue;
       const int g = static_cast<int>(seed.size());
       seed.push_back(t0);
       vertex.push_back(vertex_of(planes, s.corner[t0]));
+      through.assign(s.corner[t0].begin(), s.corner[t0].end());
       group[t0] = g;
       stack.assign(1, t0);
       while (!stack.empty()) {
@@ -365,9 +368,11 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
           for (int j = 0; j < 3; ++j)
             if (cn[j] != a && cn[j] != b) far = cn[j];
           if (far < 0) return std::nullopt;
-          const int sd = side(planes, planes[far], vertex[g]);
+          const bool known = std::find(through.begin(), through.end(), far) != through.end();
+          const int sd = known ? 0 : side(planes, planes[far], vertex[g]);
           if (sd > 0) return std::nullopt;
           if (sd < 0) continue;
+          if (!known) through.push_back(far);
           if (group[nb] < 0) {
             group[nb] = g;
             stack.push_back(nb);
@@ -536,7 +541,6 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   }
   return out;
 }
-
 
 /// The exact dual hull, built incrementally on the planes themselves: the dual point of a
 /// plane sees a dual triangle iff the plane cuts off the triangle's vertex (side > 0), an
@@ -840,8 +844,10 @@ MaybePolytope erode_polytope(const Polytope& A, const Polytope& B,
       const int b = location_vertex(B, loc[f]);
       if (dyadic) {
         // Double points: every product is exact in Mpzf, no rationals needed.
+        // A triangle holds its corners exactly on the plane of its Newell normal.
+        const int corners = A.degree(f) == 3 && A.given_normals.empty() ? 1 : A.degree(f);
         ExactN offset = dot(n, to_exact_n(A.points[A.corner(f, 0)]));
-        for (int k = 1; k < A.degree(f); ++k)
+        for (int k = 1; k < corners; ++k)
           offset = std::max(offset, dot(n, to_exact_n(A.points[A.corner(f, k)])));
         hs[f] = {n, offset - dot(n, to_exact_n(B.points[b])), ExactN(1), A.face_source[f]};
       } else {
