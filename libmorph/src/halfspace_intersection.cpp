@@ -33,7 +33,6 @@
 #include <deque>
 #include <map>
 #include <numeric>
-#include <unordered_map>
 
 #include "gauss_map.h"
 #include "parallel.h"
@@ -278,8 +277,8 @@ bool clockwise(const std::vector<int>& cyc, const std::vector<HVertex>& vertex,
   const int n = static_cast<int>(cyc.size());
   {
     RoundingGuard guard;
-    const V3<Interval> nw = newell_normal<Interval>(
-        n, [&](int i) -> const V3<Interval>& { return vertex[cyc[i]].xi; });
+    const V3<Interval> nw =
+        newell_normal<Interval>(n, [&](int i) -> const V3<Interval>& { return vertex[cyc[i]].xi; });
     const int s = interval_sign(dot(nw, to_interval_n(normal)));
     if (s != 2) return s < 0;
   }
@@ -289,8 +288,7 @@ bool clockwise(const std::vector<int>& cyc, const std::vector<HVertex>& vertex,
     const Exact w(v.W);
     exact[i] = {Exact(v.X.x) / w, Exact(v.X.y) / w, Exact(v.X.z) / w};
   }
-  const V3<Exact> nw =
-      newell_normal<Exact>(n, [&](int i) -> const V3<Exact>& { return exact[i]; });
+  const V3<Exact> nw = newell_normal<Exact>(n, [&](int i) -> const V3<Exact>& { return exact[i]; });
   return CGAL::sign(dot(nw, to_rational(normal))) < 0;
 }
 
@@ -584,13 +582,13 @@ class IncrementalHull {
     out = {};
     for (std::size_t t = 0; t < tris_.size(); ++t) {
       if (!tris_[t].alive) continue;
-      if (std::max({tris_[t].c[0], tris_[t].c[1], tris_[t].c[2]}) >= n_)
-        return Outcome::too_small;
+      if (std::max({tris_[t].c[0], tris_[t].c[1], tris_[t].c[2]}) >= n_) return Outcome::too_small;
       index[t] = static_cast<int>(out.corner.size());
       out.corner.push_back(tris_[t].c);
     }
     for (const Tri& t : tris_)
-      if (t.alive) out.across.push_back({index[t.across[0]], index[t.across[1]], index[t.across[2]]});
+      if (t.alive)
+        out.across.push_back({index[t.across[0]], index[t.across[1]], index[t.across[2]]});
     return Outcome::hull;
   }
 
