@@ -1,12 +1,14 @@
 // The exact half-space intersection behind erosion (libmorph/src/halfspace_intersection.h):
-// its fast route (a dual hull in doubles, verified exactly) and its fallbacks must give
-// exactly the result of the exact route, on inputs chosen so that doubles get the
-// combinatorics wrong: nearly coincident planes, planes cutting a vertex by less than an
-// ulp, many planes through one vertex, duplicate planes, rational offsets.
+// its main route (an exact incremental hull on the planes, with interval filters) must
+// give exactly the result of the exact route (CGAL's hull of exact dual points), on inputs
+// chosen so that doubles get the combinatorics wrong: nearly coincident planes, planes
+// cutting a vertex by less than an ulp, many planes through one vertex, duplicate planes,
+// rational offsets. The rounded result must be the exact one rounded to nearest.
 #include "halfspace_intersection.h"
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -44,34 +46,60 @@ std::string difference(const MaybePolytope& got, const MaybePolytope& want) {
   return "";
 }
 
-/// The intersection by the default (fast) route, checked against the exact route.
+/// Whether `r.rounded` is `r.polytope` with every coordinate rounded to nearest by mpfr.
+bool rounded_from_exact(const MaybePolytope& r) {
+  if (!r.polytope) return r.rounded.points.empty();
+  const Polytope& p = *r.polytope;
+  if (r.rounded.points.size() != p.points.size()) return false;
+  for (int v = 0; v < p.num_vertices(); ++v) {
+    const V3<Exact> e = p.exact_point(v);
+    const V3<double>& q = r.rounded.points[v];
+    if (q.x != round_to_nearest(e.x) || q.y != round_to_nearest(e.y) ||
+        q.z != round_to_nearest(e.z))
+      return false;
+  }
+  return r.rounded.face_begin == p.face_begin && r.rounded.corner_vertex == p.corner_vertex &&
+         r.rounded.face_source == p.face_source;
+}
+
+/// The intersection by the default (incremental) route, checked against the exact route;
+/// the rounded-only result is the same.
 MaybePolytope checked(const std::vector<HalfSpace>& hs, const V3<double>& hint = {0, 0, 0}) {
   MaybePolytope fast = intersect_halfspaces(hs, hint);
-  const MaybePolytope exact = intersect_halfspaces(hs, hint, {.try_doubles = false});
-  CHECK(exact.route != HullRoute::verified);
+  const MaybePolytope exact = intersect_halfspaces(hs, hint, {.incremental = false});
+  const MaybePolytope rounded = intersect_halfspaces(hs, hint, {.polytope = false});
+  CHECK(exact.route == (exact.polytope ? HullRoute::exact : HullRoute::none));
   CHECK(difference(fast, exact) == "");
+  CHECK(rounded_from_exact(fast));
+  CHECK(!rounded.polytope);
+  CHECK(std::equal(rounded.rounded.points.begin(), rounded.rounded.points.end(),
+                   fast.rounded.points.begin(), fast.rounded.points.end(),
+                   [](const V3<double>& p, const V3<double>& q) {
+                     return p.x == q.x && p.y == q.y && p.z == q.z;
+                   }));
+  CHECK(rounded.rounded.corner_vertex == fast.rounded.corner_vertex);
   return fast;
 }
 
 }  // namespace
 
-TEST_CASE("halfspace_intersection: a cube is found by the verified double hull") {
+TEST_CASE("halfspace_intersection: a cube is found by the incremental hull") {
   const MaybePolytope r = checked(cube_planes(1.0));
   REQUIRE(r.polytope);
-  CHECK(r.route == HullRoute::verified);
+  CHECK(r.route == HullRoute::incremental);
   CHECK(r.polytope->num_faces() == 6);
   CHECK(r.polytope->num_vertices() == 8);
 }
 
 // A corner of the cube cut off by 2^-60: in doubles the cutting plane's dual point lies on
-// the hull, so the double hull misses the facet. Without the exact verification the
-// result would have 6 facets.
-TEST_CASE("halfspace_intersection: a cut below double resolution is caught and redone exactly") {
+// the hull, so a hull in doubles would miss the facet (6 facets). The incremental hull
+// decides it exactly, without a fallback.
+TEST_CASE("halfspace_intersection: a cut below double resolution is found exactly") {
   std::vector<HalfSpace> hs = cube_planes(1.0);
   hs.push_back(plane(1, 1, 1, Exact(3) - Exact(std::ldexp(1.0, -60)), 6));
   const MaybePolytope r = checked(hs);
   REQUIRE(r.polytope);
-  CHECK(r.route != HullRoute::verified);
+  CHECK(r.route == HullRoute::incremental);
   CHECK(r.polytope->num_faces() == 7);
   CHECK(r.polytope->num_vertices() == 10);
 }
@@ -122,10 +150,9 @@ TEST_CASE("halfspace_intersection: many planes through a rational apex") {
 
 // Nearly coincident planes: tangent planes of the unit sphere around the north pole,
 // slightly tilted and moved by less than an ulp of their offsets, so that rounding the
-// offsets changes the combinatorics. Some of these must defeat the double hull (so the
-// fallback runs), and every one must agree with the exact route.
+// offsets changes the combinatorics (a hull in doubles gets these wrong). Every one must
+// agree with the exact route, without a fallback.
 TEST_CASE("halfspace_intersection: nearly coincident planes") {
-  int fallbacks = 0;
   for (int seed = 0; seed < 12; ++seed) {
     std::vector<HalfSpace> hs = cube_planes(2.0);
     hs[4] = plane(0, 0, 1, Exact(4), 4);  // room above the cap
@@ -138,9 +165,8 @@ TEST_CASE("halfspace_intersection: nearly coincident planes") {
     }
     const MaybePolytope r = checked(hs);
     REQUIRE(r.polytope);
-    fallbacks += r.route != HullRoute::verified;
+    CHECK(r.route == HullRoute::incremental);
   }
-  CHECK(fallbacks > 0);
 }
 
 // The same plane twice (scaled by 3, with a later index): the facet keeps the smaller

@@ -3,18 +3,19 @@
 // intersection are the dual points that are vertices of their convex hull, and its
 // vertices are the hull's facets.
 //
-// Fast route: the dual hull of the points rounded to doubles (CGAL, Epick), then an exact
-// check that its combinatorics are those of the exact hull (Mehlhorn et al., "Checking
-// geometric programs or verification of geometric structures", 1999): a closed
-// triangulated surface around o, locally convex at every edge, that a ray from o crosses
-// once, is the boundary of its convex hull; the hull holds every other dual point iff
-// its plane does not cut the candidate polytope, which a walk on the (convex) candidate
-// decides. All tests are on the planes as dyadic homogeneous coordinates (Mpzf, no gcd),
-// interval-filtered. If any test fails, the exact route computes the dual hull on exact
-// rational points (Epeck). Both routes end in the same exact, canonical construction.
+// Main route: an exact randomised incremental hull built on the planes themselves (every
+// test is on the planes as dyadic homogeneous coordinates, Mpzf without gcd, interval-
+// filtered), so exact degeneracies such as four planes through a vertex need no fallback.
+// Its result is then checked exactly (Mehlhorn et al., "Checking geometric programs or
+// verification of geometric structures", 1999): a closed triangulated surface around o,
+// locally convex at every edge, that a ray from o crosses once, is the boundary of its
+// convex hull; the hull holds every other dual point iff its plane does not cut the
+// candidate polytope, which a walk on the (convex) candidate decides. If a check fails,
+// the exact route computes the dual hull on exact rational points (CGAL). Both routes end
+// in the same exact, canonical construction; vertices are rounded exactly from their
+// homogeneous coordinates, and rationals are formed only for a polytope chained further.
 #include "halfspace_intersection.h"
 
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Lazy_kernel.h>
 #include <CGAL/QP_functions.h>
 #include <CGAL/QP_models.h>
@@ -27,9 +28,11 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <deque>
 #include <map>
 #include <numeric>
-#include <unordered_map>
 
 #include "gauss_map.h"
 #include "parallel.h"
@@ -38,7 +41,6 @@ namespace morph::detail {
 
 namespace {
 
-using FastKernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 // Exact constructions on fractions of dyadic floats, never reduced: no gcd (CGAL's Epeck
 // normalises Gmpq after every operation, which dominated the erosion's profile).
 using ExactKernel = CGAL::Lazy_kernel<CGAL::Simple_cartesian<CGAL::Quotient<ExactN>>>;
@@ -56,6 +58,9 @@ Interval to_interval_n(const ExactN& x) { return Interval(x.to_interval()); }
 V3<Interval> to_interval_n(const V3<ExactN>& p) {
   return {to_interval_n(p.x), to_interval_n(p.y), to_interval_n(p.z)};
 }
+
+/// Runs of the incremental hull, each with a reach 2^20 times larger, before the exact route.
+constexpr int kReachAttempts = 3;
 
 /// A half-space as the homogeneous plane <n, x> <= d (the HalfSpace times its
 /// denominator, so both are dyadic), with interval copies for the filters.
@@ -138,7 +143,7 @@ struct DualSurface {
 };
 
 /// The triangles of a hull computed by CGAL; empty when it is not a closed triangulated
-/// sphere (the points were flat, or rounding made them so).
+/// sphere.
 template <class HullMesh, class IndexOf>
 DualSurface surface_of(const HullMesh& hull, const IndexOf& index_of) {
   DualSurface s;
@@ -160,13 +165,16 @@ DualSurface surface_of(const HullMesh& hull, const IndexOf& index_of) {
   return s;
 }
 
-/// A vertex of the intersection in homogeneous coordinates: X / W with W > 0.
+/// A vertex of the intersection in homogeneous coordinates: X / W with W > 0, the meet
+/// of three of the planes. The exact coordinates are computed when first needed.
 struct HVertex {
-  V3<ExactN> X;
-  ExactN W;
+  std::array<int, 3> planes;
   V3<Interval> Xi;
   Interval Wi;
   V3<Interval> xi;  // Xi / Wi
+  bool has_exact = false;
+  V3<ExactN> X;
+  ExactN W;
 };
 
 /// The point of three planes (Cramer's rule); W = det(n_a, n_b, n_c).
@@ -179,22 +187,38 @@ void meet(const V3<T>& na, const T& da, const V3<T>& nb, const T& db, const V3<T
        da * bc.z + db * ca.z + dc * ab.z};
 }
 
-/// The exact and interval vertex of three planes (needs a RoundingGuard).
-HVertex vertex_of(const Plane& a, const Plane& b, const Plane& c) {
+/// The interval vertex of three planes (needs a RoundingGuard).
+HVertex vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& abc) {
   HVertex v;
-  meet(a.n, a.d, b.n, b.d, c.n, c.d, v.X, v.W);
+  v.planes = abc;
+  const Plane &a = planes[abc[0]], &b = planes[abc[1]], &c = planes[abc[2]];
   meet(a.ni, a.di, b.ni, b.di, c.ni, c.di, v.Xi, v.Wi);
   v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
   return v;
 }
 
-/// Sign of <n, x> - d at a vertex: > 0 when the vertex violates the half-space.
+/// Computes the exact coordinates of a vertex, once.
+void make_exact(const std::vector<Plane>& planes, HVertex& v) {
+  if (v.has_exact) return;
+  const Plane &a = planes[v.planes[0]], &b = planes[v.planes[1]], &c = planes[v.planes[2]];
+  meet(a.n, a.d, b.n, b.d, c.n, c.d, v.X, v.W);
+  v.has_exact = true;
+}
+
+/// Sign of <n, x> - d at a vertex: > 0 when the vertex violates the half-space. Exact
+/// coordinates are computed when the filter fails (`make_exact`), or must be there.
 int side(const Plane& p, const HVertex& v) {
   const int s = interval_sign(dot(p.ni, v.Xi) - p.di * v.Wi);
   return s != 2 ? s : CGAL::sign(dot(p.n, v.X) - p.d * v.W);
 }
+int side(const std::vector<Plane>& planes, const Plane& p, HVertex& v) {
+  const int s = interval_sign(dot(p.ni, v.Xi) - p.di * v.Wi);
+  if (s != 2) return s;
+  make_exact(planes, v);
+  return CGAL::sign(dot(p.n, v.X) - p.d * v.W);
+}
 
-/// Sign of <n, u> - <n, v>.
+/// Sign of <n, u> - <n, v> (exact coordinates there).
 int compare_along(const Plane& p, const HVertex& u, const HVertex& v) {
   const int s = interval_sign(dot(p.ni, u.xi) - dot(p.ni, v.xi));
   return s != 2 ? s : CGAL::sign(dot(p.n, u.X) * v.W - dot(p.n, v.X) * u.W);
@@ -205,10 +229,75 @@ int det_sign(const Plane& a, const Plane& b, const Plane& c) {
   return s != 2 ? s : CGAL::sign(det(a.n, b.n, c.n));
 }
 
+/// X / W (W > 0) rounded to the nearest double, ties to even: a double within an ulp or
+/// two of it, moved until X / W lies between the midpoints to its neighbours (exact
+/// comparisons in Mpzf, no rational and no gcd). The same value as mpfr's
+/// round_to_nearest(X / W), which is used when the estimate is poor or out of range.
+double round_quotient(const ExactN& X, const ExactN& W, const Interval& estimate) {
+  constexpr double kNormalRange = 0x1p1000;  // far from overflow and from subnormals
+  constexpr int kMaxSteps = 4;               // ulps from the estimate before giving up
+  const auto exactly = [&] { return round_to_nearest(Exact(X) / Exact(W)); };
+  double r = estimate.inf() / 2 + estimate.sup() / 2;
+  if (!(estimate.sup() - estimate.inf() <= std::abs(r) * 0x1p-50))
+    r = X.to_double() / W.to_double();
+  if (!(std::abs(r) < kNormalRange && std::abs(r) > 1 / kNormalRange)) return exactly();
+  const ExactN half(0.5);
+  // Sign of X / W - (a + b) / 2.
+  const auto versus_midpoint = [&](double a, double b) {
+    return CGAL::sign(X - (ExactN(a) + ExactN(b)) * half * W);
+  };
+  const auto even = [](double a, double b) {
+    std::uint64_t bits;
+    std::memcpy(&bits, &a, sizeof bits);
+    return (bits & 1) == 0 ? a : b;
+  };
+  for (int step = 0; step < kMaxSteps; ++step) {
+    const double up = std::nextafter(r, HUGE_VAL), down = std::nextafter(r, -HUGE_VAL);
+    const int above = versus_midpoint(r, up);
+    if (above > 0) {
+      r = up;
+      continue;
+    }
+    if (above == 0) return even(r, up);
+    const int below = versus_midpoint(down, r);
+    if (below < 0) {
+      r = down;
+      continue;
+    }
+    if (below == 0) return even(r, down);
+    return r;
+  }
+  return exactly();
+}
+
+/// Whether the facet cycle `cyc` runs clockwise about `normal` (interval Newell normal of
+/// the vertices, rationals when that cannot decide).
+bool clockwise(const std::vector<int>& cyc, const std::vector<HVertex>& vertex,
+               const V3<ExactN>& normal) {
+  const int n = static_cast<int>(cyc.size());
+  {
+    RoundingGuard guard;
+    const V3<Interval> nw =
+        newell_normal<Interval>(n, [&](int i) -> const V3<Interval>& { return vertex[cyc[i]].xi; });
+    const int s = interval_sign(dot(nw, to_interval_n(normal)));
+    if (s != 2) return s < 0;
+  }
+  std::vector<V3<Exact>> exact(n);
+  for (int i = 0; i < n; ++i) {
+    const HVertex& v = vertex[cyc[i]];
+    const Exact w(v.W);
+    exact[i] = {Exact(v.X.x) / w, Exact(v.X.y) / w, Exact(v.X.z) / w};
+  }
+  const V3<Exact> nw = newell_normal<Exact>(n, [&](int i) -> const V3<Exact>& { return exact[i]; });
+  return CGAL::sign(dot(nw, to_rational(normal))) < 0;
+}
+
 /// Builds the intersection from a candidate dual hull, checking exactly that it is the
-/// dual hull of all the planes; nullopt when it is not.
-std::optional<Polytope> build_verified(const std::vector<HalfSpace>& hs,
-                                       const std::vector<Plane>& planes, const DualSurface& s) {
+/// dual hull of all the planes; nullopt when it is not. The result has `rounded`, and
+/// `polytope` when `with_polytope`.
+std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
+                                            const std::vector<Plane>& planes, const DualSurface& s,
+                                            bool with_polytope) {
   const int nt = static_cast<int>(s.corner.size());
   const int n = static_cast<int>(planes.size());
   if (nt == 0) return std::nullopt;
@@ -250,18 +339,20 @@ std::optional<Polytope> build_verified(const std::vector<HalfSpace>& hs,
   }
   // Group triangles whose planes meet in one point (exactly coplanar dual triangles):
   // each group is a vertex of the intersection. Every edge between groups must be
-  // strictly convex: the far plane of each neighbour is strictly satisfied.
+  // strictly convex: the far plane of each neighbour is strictly satisfied. The planes
+  // found through the group's vertex are kept, so each is tested once (exactly, when
+  // the vertex is degenerate: the filter cannot show a zero).
   std::vector<int> group(nt, -1), seed;
   std::vector<HVertex> vertex;
   {
     RoundingGuard guard;
-    std::vector<int> stack;
+    std::vector<int> stack, through;
     for (int t0 = 0; t0 < nt; ++t0) {
       if (group[t0] >= 0) continue;
       const int g = static_cast<int>(seed.size());
       seed.push_back(t0);
-      const auto& c = s.corner[t0];
-      vertex.push_back(vertex_of(planes[c[0]], planes[c[1]], planes[c[2]]));
+      vertex.push_back(vertex_of(planes, s.corner[t0]));
+      through.assign(s.corner[t0].begin(), s.corner[t0].end());
       group[t0] = g;
       stack.assign(1, t0);
       while (!stack.empty()) {
@@ -275,9 +366,11 @@ std::optional<Polytope> build_verified(const std::vector<HalfSpace>& hs,
           for (int j = 0; j < 3; ++j)
             if (cn[j] != a && cn[j] != b) far = cn[j];
           if (far < 0) return std::nullopt;
-          const int sd = side(planes[far], vertex[g]);
+          const bool known = std::find(through.begin(), through.end(), far) != through.end();
+          const int sd = known ? 0 : side(planes, planes[far], vertex[g]);
           if (sd > 0) return std::nullopt;
           if (sd < 0) continue;
+          if (!known) through.push_back(far);
           if (group[nb] < 0) {
             group[nb] = g;
             stack.push_back(nb);
@@ -327,6 +420,10 @@ std::optional<Polytope> build_verified(const std::vector<HalfSpace>& hs,
     face_halfspace.push_back(p);
   }
   if (faces.size() < 4) return std::nullopt;
+  // Exact vertices, for the rounding and for the checks below.
+  parallel_chunks(nv, 128, [&](int begin, int end) {
+    for (int v = begin; v < end; ++v) make_exact(planes, vertex[v]);
+  });
   // The candidate is a convex polytope. Every plane that is not a dual vertex must not cut
   // it: climb to its highest vertex (a local maximum is global on a convex polytope) and
   // collect the vertices where it touches (sorted).
@@ -404,119 +501,148 @@ std::optional<Polytope> build_verified(const std::vector<HalfSpace>& hs,
   }
   faces = std::move(sorted_faces);
   face_halfspace = std::move(sorted_halfspace);
-  // Exact rational vertices, once each.
-  std::vector<V3<Exact>> exact(nv);
-  std::vector<V3<double>> rounded(nv);
+  // Circulating around a dual vertex may run clockwise: orient by the first facet.
+  {
+    std::vector<int> cyc = faces[0];
+    for (int& r : cyc) r = order[r];
+    if (clockwise(cyc, vertex, hs[face_halfspace[0]].normal))
+      for (auto& c : faces) std::reverse(c.begin(), c.end());
+  }
+  // Rounded vertices, exactly rounded from the homogeneous coordinates; rationals only
+  // for a polytope that is computed with further.
+  MaybePolytope out;
+  RoundedPolytope& rp = out.rounded;
+  rp.points.resize(nv);
+  std::vector<V3<Exact>> exact(with_polytope ? nv : 0);
   parallel_chunks(nv, 128, [&](int begin, int end) {
     for (int r = begin; r < end; ++r) {
       const HVertex& v = vertex[order[r]];
+      rp.points[r] = {round_quotient(v.X.x, v.W, v.xi.x), round_quotient(v.X.y, v.W, v.xi.y),
+                      round_quotient(v.X.z, v.W, v.xi.z)};
+      if (!with_polytope) continue;
       const Exact w(v.W);
       exact[r] = {Exact(v.X.x) / w, Exact(v.X.y) / w, Exact(v.X.z) / w};
-      rounded[r] = {round_to_nearest(exact[r].x), round_to_nearest(exact[r].y),
-                    round_to_nearest(exact[r].z)};
     }
   });
-  // Circulating around a dual vertex may run clockwise: orient by the first facet.
-  {
-    const auto& cyc = faces[0];
-    const V3<Exact> nw = newell_normal<Exact>(
-        static_cast<int>(cyc.size()), [&](int i) -> const V3<Exact>& { return exact[cyc[i]]; });
-    if (CGAL::sign(dot(nw, to_rational(hs[face_halfspace[0]].normal))) < 0)
-      for (auto& c : faces) std::reverse(c.begin(), c.end());
+  rp.face_begin.assign(1, 0);
+  for (std::size_t f = 0; f < faces.size(); ++f) {
+    rp.corner_vertex.insert(rp.corner_vertex.end(), faces[f].begin(), faces[f].end());
+    rp.face_begin.push_back(static_cast<int>(rp.corner_vertex.size()));
+    rp.face_source.push_back(hs[face_halfspace[f]].source);
   }
-  std::vector<V3<ExactN>> normals(faces.size());
-  for (std::size_t f = 0; f < faces.size(); ++f) normals[f] = hs[face_halfspace[f]].normal;
-  Polytope p =
-      make_polytope(std::move(rounded), std::move(exact), faces, std::move(normals), "A (-) B");
-  for (auto& src : p.face_source) src = hs[face_halfspace[src]].source;
-  return p;
+  if (with_polytope) {
+    std::vector<V3<ExactN>> normals(faces.size());
+    for (std::size_t f = 0; f < faces.size(); ++f) normals[f] = hs[face_halfspace[f]].normal;
+    Polytope p = make_polytope(rp.points, std::move(exact), faces, std::move(normals), "A (-) B");
+    for (auto& src : p.face_source) src = hs[face_halfspace[src]].source;
+    out.polytope = std::move(p);
+  }
+  return out;
 }
 
 /// The exact dual hull, built incrementally on the planes themselves: the dual point of a
 /// plane sees a dual triangle iff the plane cuts off the triangle's vertex (side > 0), an
 /// interval-filtered test on dyadic homogeneous coordinates, exact only when undecided.
-/// Randomised insertion order (fixed seed) with one conflict triangle per pending plane.
-/// Returns an empty surface when it meets an inconsistency; the caller verifies the result
-/// like any candidate.
+/// Randomised insertion order (fixed seed); each pending plane keeps one triangle it sees
+/// and, when that one is replaced, looks among the new triangles only (as in Quickhull:
+/// a plane that sees none of them no longer cuts the intersection). Exact degeneracies
+/// need no care: a plane through a vertex (side 0) sees nothing, and exactly coplanar
+/// dual triangles are grouped by the builder. Starts from four virtual planes, a regular
+/// tetrahedron around o reaching `reach` beyond it; if one is left on the hull the
+/// tetrahedron did not hold the intersection (run again with a larger reach).
 class IncrementalHull {
  public:
-  explicit IncrementalHull(const std::vector<Plane>& planes) : planes_(planes) {}
+  enum class Outcome { hull, too_small, failed };
 
-  /// `reach`: a bound on the distance from o to the intersection (checked: a virtual plane
-  /// left on the hull makes the run fail).
-  DualSurface run(const V3<double>& o, double reach) {
+  IncrementalHull(const std::vector<Plane>& planes, const V3<double>& o, double reach)
+      : planes_(planes), n_(static_cast<int>(planes.size())) {
+    const double dirs[4][3] = {{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}};
+    for (int k = 0; k < 4; ++k) {
+      const V3<ExactN> m{ExactN(dirs[k][0]), ExactN(dirs[k][1]), ExactN(dirs[k][2])};
+      const ExactN d = dot(m, to_exact_n(o)) + ExactN(reach);
+      virtual_[k] = {m, d, to_interval_n(m), to_interval_n(d)};
+    }
+  }
+
+  /// The hull in `out` when the outcome is `hull`.
+  Outcome run(DualSurface& out) {
     RoundingGuard guard;
-    const int n = static_cast<int>(planes_.size());
-    start(o, reach);
-    std::vector<int> order(n);
+    start();
+    std::vector<int> order(n_);
     std::iota(order.begin(), order.end(), 0);
     std::uint64_t state = 0x9e3779b97f4a7c15ull;  // fixed seed: the result must not vary
-    for (int i = n - 1; i > 0; --i) {
+    for (int i = n_ - 1; i > 0; --i) {
       state = state * 6364136223846793005ull + 1442695040888963407ull;
       std::swap(order[i],
                 order[static_cast<int>((state >> 33) % static_cast<std::uint64_t>(i + 1))]);
     }
     for (int p : order)
-      if (conflict_[p] >= 0 && !insert(p)) return {};
-    DualSurface s;
-    for (const Tri& t : tris_)
-      if (t.alive && std::max({t.c[0], t.c[1], t.c[2]}) >= n) return {};
+      if (conflict_[p] >= 0 && !insert(p)) return Outcome::failed;
     std::vector<int> index(tris_.size(), -1);
-    for (std::size_t t = 0; t < tris_.size(); ++t)
-      if (tris_[t].alive)
-        index[t] = static_cast<int>(s.corner.size()), s.corner.push_back(tris_[t].c);
-    for (const Tri& t : tris_) {
-      if (!t.alive) continue;
-      s.across.push_back({index[t.across[0]], index[t.across[1]], index[t.across[2]]});
+    out = {};
+    for (std::size_t t = 0; t < tris_.size(); ++t) {
+      if (!tris_[t].alive) continue;
+      if (std::max({tris_[t].c[0], tris_[t].c[1], tris_[t].c[2]}) >= n_) return Outcome::too_small;
+      index[t] = static_cast<int>(out.corner.size());
+      out.corner.push_back(tris_[t].c);
     }
-    return s;
+    for (const Tri& t : tris_)
+      if (t.alive)
+        out.across.push_back({index[t.across[0]], index[t.across[1]], index[t.across[2]]});
+    return Outcome::hull;
   }
 
  private:
   struct Tri {
-    std::array<int, 3> c, across;
-    V3<Interval> Xi;
+    std::array<int, 3> c, across;  // edge k runs from corner k to corner k + 1
+    V3<Interval> Xi;               // the vertex of the three planes, X / W
     Interval Wi;
-    bool exact = false, alive = true;
+    int exact = -1;    // its exact coordinates in exact_, once computed
+    int pending = -1;  // first of the planes that see it (linked by next_pending_)
+    bool alive = true;
+  };
+  struct ExactVertex {
     V3<ExactN> X;
     ExactN W;
-    std::vector<int> conflicts;
   };
+
+  const Plane& plane(int i) const { return i < n_ ? planes_[i] : virtual_[i - n_]; }
 
   int add(int a, int b, int c) {
     Tri t;
     t.c = {a, b, c};
     t.across = {-1, -1, -1};
-    meet(planes_[a].ni, planes_[a].di, planes_[b].ni, planes_[b].di, planes_[c].ni, planes_[c].di,
-         t.Xi, t.Wi);
-    tris_.push_back(std::move(t));
+    const Plane &pa = plane(a), &pb = plane(b), &pc = plane(c);
+    meet(pa.ni, pa.di, pb.ni, pb.di, pc.ni, pc.di, t.Xi, t.Wi);
+    tris_.push_back(t);
     return static_cast<int>(tris_.size()) - 1;
   }
 
   int side_of(int p, int t) {
     Tri& tri = tris_[t];
-    const Plane& h = planes_[p];
+    const Plane& h = plane(p);
     const int s = interval_sign(dot(h.ni, tri.Xi) - h.di * tri.Wi);
     if (s != 2) return s;
-    if (!tri.exact) {
-      const Plane &a = planes_[tri.c[0]], &b = planes_[tri.c[1]], &c = planes_[tri.c[2]];
-      meet(a.n, a.d, b.n, b.d, c.n, c.d, tri.X, tri.W);
-      tri.exact = true;
+    if (tri.exact < 0) {
+      const Plane &a = plane(tri.c[0]), &b = plane(tri.c[1]), &c = plane(tri.c[2]);
+      ExactVertex& v = exact_.emplace_back();
+      meet(a.n, a.d, b.n, b.d, c.n, c.d, v.X, v.W);
+      tri.exact = static_cast<int>(exact_.size()) - 1;
     }
-    return CGAL::sign(dot(h.n, tri.X) - h.d * tri.W);
+    const ExactVertex& v = exact_[tri.exact];
+    return CGAL::sign(dot(h.n, v.X) - h.d * v.W);
   }
 
-  // The start: four virtual planes, a regular tetrahedron around o reaching `reach`
-  // beyond it (their dual points lie deep inside the real hull when the tetrahedron
-  // holds the intersection), then every real plane's first conflict.
-  void start(const V3<double>& o, double reach) {
-    const int n = static_cast<int>(planes_.size());
-    const double dirs[4][3] = {{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}};
-    for (const auto& u : dirs) {
-      const V3<ExactN> m{ExactN(u[0]), ExactN(u[1]), ExactN(u[2])};
-      const ExactN d = dot(m, to_exact_n(o)) + ExactN(reach);
-      planes_.push_back({m, d, to_interval_n(m), to_interval_n(d)});
-    }
+  void see(int p, int t) {
+    conflict_[p] = t;
+    next_pending_[p] = tris_[t].pending;
+    tris_[t].pending = p;
+  }
+
+  // The tetrahedron of the virtual planes, then every real plane's first conflict.
+  void start() {
+    const int n = n_;
+    tris_.reserve(8 * static_cast<std::size_t>(n) + 16);
     // Around vertex n + 3 (det of the other three normals > 0 in this order).
     const int t0 = add(n, n + 1, n + 2), t1 = add(n + 1, n, n + 3), t2 = add(n + 2, n + 1, n + 3),
               t3 = add(n, n + 2, n + 3);
@@ -525,11 +651,12 @@ class IncrementalHull {
     tris_[t2].across = {t0, t1, t3};
     tris_[t3].across = {t0, t2, t1};
     conflict_.assign(n, -1);
+    next_pending_.assign(n, -1);
+    start_at_.assign(n + 4, -1);
     for (int p = 0; p < n; ++p) {
       for (int t = t0; t <= t3; ++t) {
         if (side_of(p, t) > 0) {
-          conflict_[p] = t;
-          tris_[t].conflicts.push_back(p);
+          see(p, t);
           break;
         }
       }
@@ -538,117 +665,92 @@ class IncrementalHull {
 
   bool insert(int p) {
     // The visible triangles (connected), and the horizon around them.
-    std::vector<int> visible{conflict_[p]};
-    tris_[visible[0]].alive = false;
-    std::vector<std::pair<int, int>> horizon;  // (visible triangle, edge)
-    for (std::size_t q = 0; q < visible.size(); ++q) {
-      const int t = visible[q];
+    visible_.assign(1, conflict_[p]);
+    tris_[visible_[0]].alive = false;
+    horizon_.clear();
+    for (std::size_t q = 0; q < visible_.size(); ++q) {
+      const int t = visible_[q];
       for (int k = 0; k < 3; ++k) {
         const int nb = tris_[t].across[k];
         if (!tris_[nb].alive) continue;
         if (side_of(p, nb) > 0) {
           tris_[nb].alive = false;
-          visible.push_back(nb);
+          visible_.push_back(nb);
         } else {
-          horizon.emplace_back(t, k);
+          horizon_.emplace_back(t, k);
         }
       }
     }
     // A horizon edge may have been recorded before its far triangle turned out visible.
-    horizon.erase(std::remove_if(
-                      horizon.begin(), horizon.end(),
-                      [&](const auto& h) { return !tris_[tris_[h.first].across[h.second]].alive; }),
-                  horizon.end());
+    horizon_.erase(std::remove_if(horizon_.begin(), horizon_.end(),
+                                  [&](const auto& h) {
+                                    return !tris_[tris_[h.first].across[h.second]].alive;
+                                  }),
+                   horizon_.end());
     // One new triangle (u, w, p) per horizon edge u -> w, linked around p.
-    std::unordered_map<int, int> by_start, by_end;
-    std::vector<int> created;
-    for (const auto& [t, k] : horizon) {
+    created_.clear();
+    bool ok = true;
+    for (const auto& [t, k] : horizon_) {
       const int u = tris_[t].c[k], w = tris_[t].c[(k + 1) % 3];
       const int kept = tris_[t].across[k];
       const int nt = add(u, w, p);
       tris_[nt].across[0] = kept;
       int j = 0;
       while (j < 3 && tris_[kept].across[j] != t) ++j;
-      if (j == 3) return false;
+      if (j == 3 || start_at_[u] >= 0) ok = false;
+      if (!ok) break;
       tris_[kept].across[j] = nt;
-      if (!by_start.emplace(u, nt).second || !by_end.emplace(w, nt).second) return false;
-      created.push_back(nt);
+      start_at_[u] = nt;
+      created_.push_back(nt);
     }
-    for (int nt : created) {
-      const auto s_it = by_start.find(tris_[nt].c[1]), e_it = by_end.find(tris_[nt].c[0]);
-      if (s_it == by_start.end() || e_it == by_end.end()) return false;
-      tris_[nt].across[1] = s_it->second;
-      tris_[nt].across[2] = e_it->second;
+    for (int nt : created_) {
+      const int next = start_at_[tris_[nt].c[1]];
+      if (next < 0) ok = false;
+      if (!ok) break;
+      tris_[nt].across[1] = next;
+      tris_[next].across[2] = nt;
     }
-    // Pending planes of the removed triangles look for a new one they see.
-    for (int t : visible) {
-      for (int q : tris_[t].conflicts) {
-        if (q == p) continue;
+    for (int nt : created_) start_at_[tris_[nt].c[0]] = -1;
+    if (!ok) return false;
+    // Pending planes of the removed triangles look for a new triangle they see.
+    for (int t : visible_) {
+      for (int q = tris_[t].pending, next; q >= 0; q = next) {
+        next = next_pending_[q];
         conflict_[q] = -1;
-        for (int nt : created) {
+        if (q == p) continue;
+        for (int nt : created_) {
           if (side_of(q, nt) > 0) {
-            conflict_[q] = nt;
+            see(q, nt);
             break;
           }
         }
-        if (conflict_[q] < 0) {
-          for (int s = 0; s < static_cast<int>(tris_.size()); ++s) {
-            if (tris_[s].alive && side_of(q, s) > 0) {
-              conflict_[q] = s;
-              break;
-            }
-          }
-        }
-        if (conflict_[q] >= 0) tris_[conflict_[q]].conflicts.push_back(q);
       }
-      std::vector<int>().swap(tris_[t].conflicts);
+      tris_[t].pending = -1;
     }
-    conflict_[p] = -1;
     return true;
   }
 
-  std::vector<Plane> planes_;  // and the virtual ones
+  const std::vector<Plane>& planes_;
+  int n_;
+  std::array<Plane, 4> virtual_;
   std::vector<Tri> tris_;
-  std::vector<int> conflict_;
+  std::deque<ExactVertex> exact_;
+  std::vector<int> conflict_, next_pending_;  // per real plane
+  std::vector<int> start_at_;                 // per plane: new triangle starting there
+  std::vector<int> visible_, created_;
+  std::vector<std::pair<int, int>> horizon_;
 };
 
-/// A power of two well beyond the distance from o to the vertices of a candidate hull.
-double reach(const std::vector<Plane>& planes, const DualSurface& guess, const V3<double>& o) {
-  const auto approx = [&](int i) {
-    return V3<double>{planes[i].n.x.to_double(), planes[i].n.y.to_double(),
-                      planes[i].n.z.to_double()};
-  };
-  double r = 1.0;
-  for (const auto& c : guess.corner) {
-    V3<double> x;
-    double w;
-    meet(approx(c[0]), planes[c[0]].d.to_double(), approx(c[1]), planes[c[1]].d.to_double(),
-         approx(c[2]), planes[c[2]].d.to_double(), x, w);
-    const double dist = std::abs(x.x / w - o.x) + std::abs(x.y / w - o.y) + std::abs(x.z / w - o.z);
+/// A power of two that the distance (L1) from o to the intersection's vertices most likely
+/// stays below: a few times the largest distance from o to a plane (the run checks it).
+double first_reach(const std::vector<Plane>& planes, const V3<double>& o) {
+  double r = 0;
+  for (const Plane& p : planes) {
+    const V3<double> n{p.n.x.to_double(), p.n.y.to_double(), p.n.z.to_double()};
+    const double dist = (p.d.to_double() - dot(n, o)) / std::sqrt(dot(n, n));
     if (std::isfinite(dist)) r = std::max(r, dist);
   }
-  return std::ldexp(1.0, std::ilogb(r) + 4);
-}
-
-/// The dual hull of the points rounded to doubles (about o rounded to doubles).
-DualSurface double_dual_hull(const std::vector<Plane>& planes, const V3<double>& o) {
-  using Point = FastKernel::Point_3;
-  const int n = static_cast<int>(planes.size());
-  std::vector<Point> points(n);
-  std::map<Point, int> index_of;
-  for (int i = 0; i < n; ++i) {
-    const V3<double> nd{planes[i].n.x.to_double(), planes[i].n.y.to_double(),
-                        planes[i].n.z.to_double()};
-    const double w = planes[i].d.to_double() - dot(nd, o);
-    const Point y(nd.x / w, nd.y / w, nd.z / w);
-    if (!(w > 0) || !std::isfinite(y.x()) || !std::isfinite(y.y()) || !std::isfinite(y.z()))
-      return {};
-    points[i] = y;
-    index_of.emplace(y, i);
-  }
-  CGAL::Surface_mesh<Point> hull;
-  CGAL::convex_hull_3(points.begin(), points.end(), hull);
-  return surface_of(hull, [&](const Point& y) { return index_of.at(y); });
+  return std::ldexp(1.0, std::ilogb(std::max(r, 1e-300)) + 4);
 }
 
 /// The dual hull of the exact dual points about o: n / (d - <n, o>), with o = p / q
@@ -706,29 +808,30 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
     o_double = {round_to_nearest(o.x), round_to_nearest(o.y), round_to_nearest(o.z)};
   }
   // The verification does not depend on o: any exact interior point (there is one) makes
-  // the duality argument hold, so the rounded o only has to give good double points.
-  if (options.try_doubles) {
-    const DualSurface guess = double_dual_hull(planes, o_double);
-    if (auto p = build_verified(hs, planes, guess)) {
-      out.polytope = std::move(p);
-      out.route = HullRoute::verified;
-      return out;
-    }
-    if (auto p = build_verified(
-            hs, planes, IncrementalHull(planes).run(o_double, reach(planes, guess, o_double)))) {
-      out.polytope = std::move(p);
-      out.route = HullRoute::incremental;
-      return out;
+  // the duality argument hold, so the rounded o only has to centre the virtual planes.
+  if (options.incremental) {
+    double reach = first_reach(planes, o_double);
+    for (int attempt = 0; attempt < kReachAttempts; ++attempt, reach = std::ldexp(reach, 20)) {
+      DualSurface s;
+      const auto outcome = IncrementalHull(planes, o_double, reach).run(s);
+      if (outcome == IncrementalHull::Outcome::too_small) continue;
+      if (outcome == IncrementalHull::Outcome::hull) {
+        if (auto built = build_verified(hs, planes, s, options.polytope)) {
+          built->route = HullRoute::incremental;
+          return std::move(*built);
+        }
+      }
+      break;
     }
   }
-  out.polytope = build_verified(hs, planes, exact_dual_hull(planes, o));
-  if (!out.polytope)
-    throw error("internal error: the exact dual hull of an erosion failed its own check");
-  out.route = HullRoute::exact;
-  return out;
+  auto built = build_verified(hs, planes, exact_dual_hull(planes, o), options.polytope);
+  if (!built) throw error("internal error: the exact dual hull of an erosion failed its own check");
+  built->route = HullRoute::exact;
+  return std::move(*built);
 }
 
-MaybePolytope erode_polytope(const Polytope& A, const Polytope& B) {
+MaybePolytope erode_polytope(const Polytope& A, const Polytope& B,
+                             const IntersectOptions& options) {
   const std::vector<Location> loc = locate_all(A, B);
   const int nf = A.num_faces();
   std::vector<HalfSpace> hs(nf);
@@ -739,8 +842,10 @@ MaybePolytope erode_polytope(const Polytope& A, const Polytope& B) {
       const int b = location_vertex(B, loc[f]);
       if (dyadic) {
         // Double points: every product is exact in Mpzf, no rationals needed.
+        // A triangle holds its corners exactly on the plane of its Newell normal.
+        const int corners = A.degree(f) == 3 && A.given_normals.empty() ? 1 : A.degree(f);
         ExactN offset = dot(n, to_exact_n(A.points[A.corner(f, 0)]));
-        for (int k = 1; k < A.degree(f); ++k)
+        for (int k = 1; k < corners; ++k)
           offset = std::max(offset, dot(n, to_exact_n(A.points[A.corner(f, k)])));
         hs[f] = {n, offset - dot(n, to_exact_n(B.points[b])), ExactN(1), A.face_source[f]};
       } else {
@@ -758,7 +863,7 @@ MaybePolytope erode_polytope(const Polytope& A, const Polytope& B) {
   for (const auto& p : B.points) cb = cb + p;
   const double ka = 1.0 / A.num_vertices(), kb = 1.0 / B.num_vertices();
   return intersect_halfspaces(
-      hs, {ca.x * ka - cb.x * kb, ca.y * ka - cb.y * kb, ca.z * ka - cb.z * kb});
+      hs, {ca.x * ka - cb.x * kb, ca.y * ka - cb.y * kb, ca.z * ka - cb.z * kb}, options);
 }
 
 }  // namespace morph::detail

@@ -29,14 +29,24 @@ HalfSpace make_halfspace(const V3<ExactN>& normal, const Exact& offset, int sour
 /// Which hull gave an intersection (for tests and profiling).
 enum class HullRoute : unsigned char {
   none,         // empty or flat: no hull
-  verified,     // the dual hull in doubles, verified exactly
-  incremental,  // the double hull failed its check: an exact incremental hull on the planes
-  exact,        // CGAL's hull of the exact dual points (both failed, or were not tried)
+  incremental,  // the exact incremental hull on the planes, checked exactly
+  exact,        // CGAL's hull of the exact dual points (its check failed, or it was not tried)
+};
+
+/// An intersection as it is written out: its vertices rounded to nearest (from their exact
+/// values), and facet cycles counter-clockwise about the outward normal. The same
+/// numbering as the polytope's, when there is one.
+struct RoundedPolytope {
+  std::vector<V3<double>> points;
+  std::vector<int> face_begin;     // size F + 1
+  std::vector<int> corner_vertex;  // corner k of facet f: corner_vertex[face_begin[f] + k]
+  std::vector<int> face_source;    // the `source` of each facet's half-space
 };
 
 /// A polytope, or why there is none.
 struct MaybePolytope {
-  std::optional<Polytope> polytope;
+  std::optional<Polytope> polytope;  // exact, when IntersectOptions::polytope
+  RoundedPolytope rounded;           // whenever the intersection is a solid
   EmptyReason reason = EmptyReason::none;
   std::string message;
   HullRoute route = HullRoute::none;
@@ -44,18 +54,21 @@ struct MaybePolytope {
 
 /// Options of intersect_halfspaces.
 struct IntersectOptions {
-  bool try_doubles = true;  // false: go straight to the exact hull (tests compare the routes)
+  bool incremental = true;  // false: go straight to the exact hull (tests compare the routes)
+  bool polytope = true;     // false: only `rounded` (a final result: no rationals, no Polytope)
 };
 
 /// The intersection of bounded half-spaces (their normals must positively span space).
 /// `hint` is a point that is often strictly inside (checked exactly; an exact linear
 /// program finds one otherwise). Empty or flat intersections are reported, not thrown.
 /// The result is exact and canonical (numbered by the half-spaces through each vertex),
-/// whichever route computed it. Expected O(n log n) for n half-spaces.
+/// whichever route computed it. Expected O(n log n) for n half-spaces (exact arithmetic
+/// only where interval filters cannot decide).
 MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& halfspaces, const V3<double>& hint,
                                    const IntersectOptions& options = {});
 
 /// A (-) B = intersection over facets f of A of { x : <N_f, x> <= h_A(N_f) - h_B(N_f) }.
-MaybePolytope erode_polytope(const Polytope& A, const Polytope& B);
+MaybePolytope erode_polytope(const Polytope& A, const Polytope& B,
+                             const IntersectOptions& options = {});
 
 }  // namespace morph::detail

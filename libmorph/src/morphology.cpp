@@ -31,12 +31,14 @@ MorphResult from_sum(const Polytope& a, const Polytope& b) {
   return r;
 }
 
-MorphResult from_polytope(const Polytope& p) {
+MorphResult from_rounded(const detail::RoundedPolytope& p) {
   MorphResult r;
-  std::vector<int> corners(p.corner_vertex.begin(), p.corner_vertex.end());
-  r.mesh = detail::clean_mesh(p.points, p.face_begin, corners, nullptr);
+  r.mesh = detail::clean_mesh(p.points, p.face_begin, p.corner_vertex, nullptr);
   return r;
 }
+
+// A final erosion is only written out: no exact polytope.
+constexpr detail::IntersectOptions kFinal{.polytope = false};
 
 }  // namespace
 
@@ -50,8 +52,8 @@ MorphResult dilate(const Mesh& A, const Mesh& B, const MorphologyOptions& option
 MorphResult erode(const Mesh& A, const Mesh& B, const MorphologyOptions& options) {
   return detail::run_with_threads(options.threads, [&] {
     const Operands op = prepare(A, B);
-    const detail::MaybePolytope e = detail::erode_polytope(op.a, op.b);
-    return e.polytope ? from_polytope(*e.polytope) : empty_result(e);
+    const detail::MaybePolytope e = detail::erode_polytope(op.a, op.b, kFinal);
+    return e.reason == EmptyReason::none ? from_rounded(e.rounded) : empty_result(e);
   });
 }
 
@@ -67,8 +69,8 @@ MorphResult close(const Mesh& A, const Mesh& B, const MorphologyOptions& options
   return detail::run_with_threads(options.threads, [&] {
     const Operands op = prepare(A, B);
     const Polytope s = detail::sum_polytope(op.a, op.b, detail::fims_facets(op.a, op.b));
-    const detail::MaybePolytope e = detail::erode_polytope(s, op.b);
-    return e.polytope ? from_polytope(*e.polytope) : empty_result(e);
+    const detail::MaybePolytope e = detail::erode_polytope(s, op.b, kFinal);
+    return e.reason == EmptyReason::none ? from_rounded(e.rounded) : empty_result(e);
   });
 }
 
