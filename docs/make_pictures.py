@@ -5,7 +5,7 @@
 
 BUILD_DIR is a configured and built libmorph tree (its apps/ holds mesh-dilate,
 mesh-erode, mesh-open and mesh-close). The script runs the apps on samples/ into a
-temporary directory, with --label-facets where the result has facet origins, reads the
+temporary directory, with --label-facets, reads the
 coloured OFF files back and renders PNGs with matplotlib (mplot3d, flat shading by facet
 normal, back faces culled, orthographic view). Needs Debian 12's python3-matplotlib.
 
@@ -310,9 +310,9 @@ def picture_morphology(apps, palette, out_dir):
     se = os.path.join(apps.work, "sphere_r0.2.off")
     write_off(se, b)
     a = read_off(a_path)
-    eroded = apps.run("mesh-erode", a_path, se, "eroded", labels=False)
+    eroded = apps.run("mesh-erode", a_path, se, "eroded")
     opened = apps.run("mesh-open", a_path, se, "opened")
-    closed = apps.run("mesh-close", a_path, se, "closed", labels=False)
+    closed = apps.run("mesh-close", a_path, se, "closed")
     dilated = apps.run("mesh-dilate", a_path, se, "dilated")
     fig = plt.figure(figsize=(8, 6))
     grid = fig.add_gridspec(2, 3, left=0, right=1, top=0.95, bottom=0.07, wspace=0, hspace=0.05)
@@ -331,7 +331,7 @@ def picture_morphology(apps, palette, out_dir):
         set_extent(ax, 0.74 * r)
         ax.set_title(title, fontsize=10, y=0.9)
     legend(fig, palette, loc="lower center", ncol=3, fontsize=8.5, bbox_to_anchor=(0.5, 0.0))
-    fig.text(0.5, 0.055, "grey: results of an erosion (no facet origins); dashed: A", ha="center", fontsize=8.5)
+    fig.text(0.5, 0.055, "dashed: A", ha="center", fontsize=8.5)
     save(fig, os.path.join(out_dir, "morphology.png"))
 
 

@@ -172,7 +172,7 @@ struct RunStats {
   std::size_t vertices = 0;
   std::size_t edges = 0;
   std::size_t facets = 0;
-  // Facet counts by origin; absent when the result has no origins (erosion, no op).
+  // Facet counts by origin; absent when the result has no origins (no operation).
   std::optional<std::size_t> translated, corner, edge;
   bool empty = false;
   std::string empty_reason = "none";  // "none", "empty" or "flat"

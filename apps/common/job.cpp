@@ -173,8 +173,7 @@ JobResult run_job(const Job& job, const JobSettings& settings, Reporter& reporte
       }
       current = std::move(step_result.mesh);
       origins = std::move(step_result.origins);
-      // Dilation and opening label every facet; closing ends with an erosion and
-      // erosion's facets carry no origin (MorphResult::origins is then empty).
+      // Every operation labels every facet (MorphResult::origins).
       has_origins = !origins.empty();
       if (has_origins && origins.size() != current.n_faces()) {
         throw std::logic_error("'" + label + "' returned " + std::to_string(origins.size()) +
@@ -232,8 +231,8 @@ JobResult run_job(const Job& job, const JobSettings& settings, Reporter& reporte
           std::call_once(g_warned_labels_erosion, [&] {
             reporter.warning(
                 output_name,
-                "--label-facets: the result of an erosion or a closing (or of no operation) has "
-                "no facet origins; no colours written");
+                "--label-facets: the result of no operation has no facet origins; no colours "
+                "written");
           });
         }
       }

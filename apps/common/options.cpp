@@ -90,8 +90,8 @@ std::string label_palette_help() {
          "  corner      230 159 0   orange  a facet of the element placed at a vertex of the "
          "input\n"
          "  edge        0 158 115   green   a parallelogram: an input edge (+) an element edge\n"
-         "  (results of erode and close end with an erosion: no origins, written without "
-         "colours)\n";
+         "  (an erosion's facets are facets of the input moved inwards by a vertex of the element:\n"
+         "  translated; a closing's are the translated facets of the dilation they lie on)\n";
 }
 
 namespace {

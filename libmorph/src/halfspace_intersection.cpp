@@ -529,6 +529,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     rp.corner_vertex.insert(rp.corner_vertex.end(), faces[f].begin(), faces[f].end());
     rp.face_begin.push_back(static_cast<int>(rp.corner_vertex.size()));
     rp.face_source.push_back(hs[face_halfspace[f]].source);
+    rp.face_element.push_back(hs[face_halfspace[f]].element);
   }
   if (with_polytope) {
     std::vector<V3<ExactN>> normals(faces.size());
@@ -847,13 +848,15 @@ MaybePolytope erode_polytope(const Polytope& A, const Polytope& B,
         ExactN offset = dot(n, to_exact_n(A.points[A.corner(f, 0)]));
         for (int k = 1; k < corners; ++k)
           offset = std::max(offset, dot(n, to_exact_n(A.points[A.corner(f, k)])));
-        hs[f] = {n, offset - dot(n, to_exact_n(B.points[b])), ExactN(1), A.face_source[f]};
+        hs[f] = {n, offset - dot(n, to_exact_n(B.points[b])), ExactN(1), A.face_source[f],
+                 B.vertex_source[b]};
       } else {
         const V3<Exact> nr = to_rational(n);
         Exact offset = dot(nr, A.exact_point(A.corner(f, 0)));
         for (int k = 1; k < A.degree(f); ++k)
           offset = std::max(offset, dot(nr, A.exact_point(A.corner(f, k))));
         hs[f] = make_halfspace(n, offset - dot(nr, B.exact_point(b)), A.face_source[f]);
+        hs[f].element = B.vertex_source[b];
       }
     }
   });

@@ -14,13 +14,14 @@ namespace morph::detail {
 
 /// A closed half-space { x : <normal, x> <= offset / denominator }, exact. Dyadic offsets
 /// (polytopes with double or dyadic points) have denominator 1; a rational offset p/q is
-/// stored as offset p, denominator q. `source` is a facet index carried to the result's
-/// facet labels.
+/// stored as offset p, denominator q. `source` and `element` are carried to the facets of
+/// the result for their labels.
 struct HalfSpace {
   V3<ExactN> normal;  // dyadic: a facet normal of a polytope; becomes the result facet's normal
   ExactN offset;
   ExactN denominator = ExactN(1);  // positive
-  int source = -1;
+  int source = -1;                 // erosion: the facet of A (its label)
+  int element = -1;                // erosion: the vertex of B that moved it inwards (its label)
 };
 
 /// The half-space <normal, x> <= offset for any rational offset.
@@ -41,6 +42,7 @@ struct RoundedPolytope {
   std::vector<int> face_begin;     // size F + 1
   std::vector<int> corner_vertex;  // corner k of facet f: corner_vertex[face_begin[f] + k]
   std::vector<int> face_source;    // the `source` of each facet's half-space
+  std::vector<int> face_element;   // the `element` of each facet's half-space
 };
 
 /// A polytope, or why there is none.

@@ -26,15 +26,28 @@ MorphResult empty_result(const detail::MaybePolytope& m) {
 MorphResult from_sum(const Polytope& a, const Polytope& b) {
   LabelledMesh s = detail::sum_mesh(a, b, detail::fims_facets(a, b));
   MorphResult r;
-  r.mesh = std::move(s.mesh);
+  r.mesh = std::move(s.mesh);  // a copy (OpenMesh has no move), a few microseconds
   r.origins = std::move(s.origins);
   return r;
 }
 
-MorphResult from_rounded(const detail::RoundedPolytope& p) {
+/// The mesh of an erosion's result, each face labelled by origin_of(facet of `p`).
+template <class OriginOf>
+MorphResult from_rounded(const detail::RoundedPolytope& p, const OriginOf& origin_of) {
   MorphResult r;
-  r.mesh = detail::clean_mesh(p.points, p.face_begin, p.corner_vertex, nullptr);
+  std::vector<int> source;
+  r.mesh = detail::clean_mesh(p.points, p.face_begin, p.corner_vertex, &source);
+  r.origins.reserve(source.size());
+  for (int f : source)
+    r.origins.push_back(f >= 0 ? origin_of(f) : FacetOrigin{FacetKind::translated, {}, {}});
   return r;
+}
+
+/// An erosion's facet: a facet of A moved inwards by a vertex of B.
+FacetOrigin erosion_origin(const detail::RoundedPolytope& p, int f) {
+  return {FacetKind::translated,
+          {Element::Kind::facet, p.face_source[f]},
+          {Element::Kind::vertex, p.face_element[f]}};
 }
 
 // A final erosion is only written out: no exact polytope.
@@ -53,7 +66,8 @@ MorphResult erode(const Mesh& A, const Mesh& B, const MorphologyOptions& options
   return detail::run_with_threads(options.threads, [&] {
     const Operands op = prepare(A, B);
     const detail::MaybePolytope e = detail::erode_polytope(op.a, op.b, kFinal);
-    return e.reason == EmptyReason::none ? from_rounded(e.rounded) : empty_result(e);
+    if (e.reason != EmptyReason::none) return empty_result(e);
+    return from_rounded(e.rounded, [&](int f) { return erosion_origin(e.rounded, f); });
   });
 }
 
@@ -68,9 +82,12 @@ MorphResult open(const Mesh& A, const Mesh& B, const MorphologyOptions& options)
 MorphResult close(const Mesh& A, const Mesh& B, const MorphologyOptions& options) {
   return detail::run_with_threads(options.threads, [&] {
     const Operands op = prepare(A, B);
-    const Polytope s = detail::sum_polytope(op.a, op.b, detail::fims_facets(op.a, op.b));
+    const detail::SumFacets sum = detail::fims_facets(op.a, op.b);
+    const Polytope s = detail::sum_polytope(op.a, op.b, sum);
     const detail::MaybePolytope e = detail::erode_polytope(s, op.b, kFinal);
-    return e.reason == EmptyReason::none ? from_rounded(e.rounded) : empty_result(e);
+    if (e.reason != EmptyReason::none) return empty_result(e);
+    // Each facet lies on a facet of A (+) B (its half-space's source): labelled as that one.
+    return from_rounded(e.rounded, [&](int f) { return sum.origins[e.rounded.face_source[f]]; });
   });
 }
 
