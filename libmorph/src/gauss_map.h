@@ -21,8 +21,9 @@ inline int orient(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
 
 /// Locates the direction `p` in P's Gauss map: the vertex whose region contains it in
 /// its interior (the contributing vertex), the edge whose arc contains it, or the facet
-/// whose normal has its direction. The walk starts at vertex `hint` and climbs the
-/// support function; it is exact. Expected O(distance walked).
+/// whose normal has its direction. The walk starts at vertex `hint`, climbs the support
+/// function in doubles (only to choose where to start), then walks exactly from region to
+/// region; the answer is exact and does not depend on the hint. Expected O(distance walked).
 Location locate(const Polytope& P, const NormalRef& p, int hint);
 
 /// A vertex of the feature `loc` (the contributing vertex when it is a vertex region).
