@@ -229,10 +229,11 @@ int det_sign(const Plane& a, const Plane& b, const Plane& c) {
   return s != 2 ? s : CGAL::sign(det(a.n, b.n, c.n));
 }
 
-/// X / W (W > 0) rounded to the nearest double, ties to even: a double within an ulp or
-/// two of it, moved until X / W lies between the midpoints to its neighbours (exact
-/// comparisons in Mpzf, no rational and no gcd). The same value as mpfr's
-/// round_to_nearest(X / W), which is used when the estimate is poor or out of range.
+}  // namespace
+
+// A double within an ulp or two of X / W, moved until X / W lies between the midpoints to
+// its neighbours (exact comparisons in Mpzf, no rational and no gcd). The same value as
+// mpfr's round_to_nearest(X / W), which is used when the estimate is poor or out of range.
 double round_quotient(const ExactN& X, const ExactN& W, const Interval& estimate) {
   constexpr double kNormalRange = 0x1p1000;  // far from overflow and from subnormals
   constexpr int kMaxSteps = 4;               // ulps from the estimate before giving up
@@ -269,6 +270,8 @@ double round_quotient(const ExactN& X, const ExactN& W, const Interval& estimate
   }
   return exactly();
 }
+
+namespace {
 
 /// Whether the facet cycle `cyc` runs clockwise about `normal` (interval Newell normal of
 /// the vertices, rationals when that cannot decide).
@@ -513,15 +516,17 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   MaybePolytope out;
   RoundedPolytope& rp = out.rounded;
   rp.points.resize(nv);
-  std::vector<V3<Exact>> exact(with_polytope ? nv : 0);
+  ExactPoints exact;
+  if (with_polytope) exact.resize(nv);
   parallel_chunks(nv, 128, [&](int begin, int end) {
     for (int r = begin; r < end; ++r) {
       const HVertex& v = vertex[order[r]];
       rp.points[r] = {round_quotient(v.X.x, v.W, v.xi.x), round_quotient(v.X.y, v.W, v.xi.y),
                       round_quotient(v.X.z, v.W, v.xi.z)};
       if (!with_polytope) continue;
-      const Exact w(v.W);
-      exact[r] = {Exact(v.X.x) / w, Exact(v.X.y) / w, Exact(v.X.z) / w};
+      exact.numerator[r] = v.X;
+      exact.denominator[r] = v.W;
+      exact.enclosure[r] = v.xi;
     }
   });
   rp.face_begin.assign(1, 0);

@@ -551,7 +551,7 @@ bool has_deleted_elements(const Mesh& mesh) {
 
 }  // namespace
 
-Polytope make_polytope(std::vector<V3<double>> points, std::vector<V3<Exact>> exact_points,
+Polytope make_polytope(std::vector<V3<double>> points, ExactPoints exact_points,
                        const std::vector<std::vector<int>>& input_faces,
                        std::vector<V3<ExactN>> given_normals, const char* name) {
   if (!exact_points.empty() && given_normals.size() != input_faces.size())
@@ -656,12 +656,18 @@ Polytope make_polytope(std::vector<V3<double>> points, std::vector<V3<Exact>> ex
       if (new_index[v] < 0) new_index[v] = used++;
   if (used != p.num_vertices()) {
     std::vector<V3<double>> pts(used);
-    std::vector<V3<Exact>> epts(p.exact_points.empty() ? 0 : used);
+    const bool exact = !p.exact_points.empty();
+    ExactPoints epts;
+    if (exact) epts.resize(used);
     std::vector<int> vsrc(used);
     for (int v = 0; v < p.num_vertices(); ++v) {
       if (new_index[v] < 0) continue;
       pts[new_index[v]] = p.points[v];
-      if (!epts.empty()) epts[new_index[v]] = p.exact_points[v];
+      if (exact) {
+        epts.numerator[new_index[v]] = p.exact_points.numerator[v];
+        epts.denominator[new_index[v]] = p.exact_points.denominator[v];
+        epts.enclosure[new_index[v]] = p.exact_points.enclosure[v];
+      }
       vsrc[new_index[v]] = v;
     }
     for (auto& cyc : faces)
