@@ -242,25 +242,32 @@ double round_quotient(const ExactN& X, const ExactN& W, const Interval& estimate
   if (!(estimate.sup() - estimate.inf() <= std::abs(r) * 0x1p-50))
     r = X.to_double() / W.to_double();
   if (!(std::abs(r) < kNormalRange && std::abs(r) > 1 / kNormalRange)) return exactly();
-  const ExactN half(0.5);
-  // Sign of X / W - (a + b) / 2.
-  const auto versus_midpoint = [&](double a, double b) {
-    return CGAL::sign(X - (ExactN(a) + ExactN(b)) * half * W);
-  };
   const auto even = [](double a, double b) {
     std::uint64_t bits;
     std::memcpy(&bits, &a, sizeof bits);
     return (bits & 1) == 0 ? a : b;
   };
+  const Interval Wi(W.to_interval());
+  RoundingGuard guard;  // for the interval filter; the rest does not depend on the mode
   for (int step = 0; step < kMaxSteps; ++step) {
     const double up = std::nextafter(r, HUGE_VAL), down = std::nextafter(r, -HUGE_VAL);
-    const int above = versus_midpoint(r, up);
+    // X / W - (r + n) / 2 = (2 R - (n - r) W) / 2W with the residual R = X - r W (one exact
+    // product per step) and n - r exact (neighbouring doubles): its sign, decided in
+    // intervals unless X / W is within rounding of the midpoint.
+    const ExactN R = X - ExactN(r) * W;
+    const Interval Ri(R.to_interval());
+    const auto versus_midpoint = [&](double n) {
+      const double gap = n - r;
+      const int s = interval_sign(Ri + Ri - Interval(gap) * Wi);
+      return s != 2 ? s : CGAL::sign(R + R - ExactN(gap) * W);
+    };
+    const int above = versus_midpoint(up);
     if (above > 0) {
       r = up;
       continue;
     }
     if (above == 0) return even(r, up);
-    const int below = versus_midpoint(down, r);
+    const int below = versus_midpoint(down);
     if (below < 0) {
       r = down;
       continue;
