@@ -404,8 +404,14 @@ int edge_convexity(const Polytope& p, const Polytope::Edge& e) {
   if (p.exact_points.empty())
     return CGAL::sign(det(p.exact_normal(e.left), p.exact_normal(e.right),
                           to_exact_n(p.points[e.to]) - to_exact_n(p.points[e.from])));
-  return CGAL::sign(det(to_rational(p.exact_normal(e.left)), to_rational(p.exact_normal(e.right)),
-                        p.exact_point(e.to) - p.exact_point(e.from)));
+  // X_to / W_to - X_from / W_from has the direction of X_to W_from - X_from W_to (W > 0):
+  // dyadic, no rationals.
+  const ExactPoints& x = p.exact_points;
+  const ExactN &w_to = x.denominator[e.to], &w_from = x.denominator[e.from];
+  const V3<ExactN>&a = x.numerator[e.to], &b = x.numerator[e.from];
+  const V3<ExactN> direction{a.x * w_from - b.x * w_to, a.y * w_from - b.y * w_to,
+                             a.z * w_from - b.z * w_to};
+  return CGAL::sign(det(p.exact_normal(e.left), p.exact_normal(e.right), direction));
 }
 
 /// The Gauss map must be valid: the normals around every vertex turn strictly
