@@ -154,6 +154,34 @@ PreciseNormal precise_newell(const std::vector<V3<double>>& points, const int* c
   return n;
 }
 
+/// The precise normal of a facet with a given exact normal (exact points): the components
+/// scaled by one power of two (exactly) so that the largest is about 1, each split into a
+/// double-double whose distance to it, an exact remainder, is enclosed for its error.
+/// Needs round-to-nearest, as the double-double stage that uses it.
+PreciseNormal precise_given(const V3<ExactN>& normal) {
+  PreciseNormal n{};
+  const ExactN* components[3] = {&normal.x, &normal.y, &normal.z};
+  double largest = 0;
+  for (const ExactN* c : components) largest = std::max(largest, std::abs(c->to_double()));
+  if (!(largest > 0) || !std::isfinite(largest)) return n;
+  const int shift = -std::ilogb(largest);
+  if (std::abs(shift) > 900) return n;  // the scale must be a double
+  const ExactN scale(std::ldexp(1.0, shift));
+  for (int i = 0; i < 3; ++i) {
+    const ExactN x = *components[i] * scale;
+    if (CGAL::sign(x) == CGAL::ZERO) continue;  // exactly zero: hi = lo = error = 0
+    const double hi = x.to_double();            // within an ulp, not necessarily nearest
+    const DD s = quick_two_sum(hi, (x - ExactN(hi)).to_double());
+    // Mpzf's enclosure is built from its limbs, whatever the rounding mode.
+    const std::pair<double, double> rest = (x - ExactN(s.hi) - ExactN(s.lo)).to_interval();
+    n.hi[i] = s.hi;
+    n.lo[i] = s.lo;
+    n.error[i] = std::max(std::abs(rest.first), std::abs(rest.second));
+  }
+  n.valid = true;
+  return n;
+}
+
 /// Upper bound on the Euclidean length of a precise normal (the sum of |components|).
 double length_bound(const PreciseNormal& n) {
   return (std::abs(n.hi[0]) + std::abs(n.hi[1]) + std::abs(n.hi[2])) * (1 + 1e-15) + n.error[0] +
@@ -167,7 +195,7 @@ double error_bound(const PreciseNormal& n) { return n.error[0] + n.error[1] + n.
 
 const PreciseNormal& Polytope::precise_normal(int f) const {
   return precise_cache_->get(f, [&] {
-    if (!exact_points.empty()) return PreciseNormal{};
+    if (!given_normals.empty()) return precise_given(given_normals[f]);
     return precise_newell(points, &corner_vertex[face_begin[f]], degree(f));
   });
 }

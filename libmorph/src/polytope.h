@@ -35,8 +35,8 @@ struct UnitNormal {
 
 /// A facet normal in double-double arithmetic (component i is hi[i] + lo[i]), times some
 /// power of two, within error[i] of the exact normal times that power in component i (a
-/// component that is exactly zero has error 0). Not `valid` when the facet's points are
-/// not doubles or do not scale exactly.
+/// component that is exactly zero has error 0). Not `valid` when the facet's points (or
+/// its given normal) do not scale exactly.
 struct PreciseNormal {
   double hi[3], lo[3];
   double error[3];
@@ -121,8 +121,9 @@ struct Polytope {
   /// normals; call after the facets are final.
   void compute_normals();
 
-  /// Newell's normal of facet f in double-double arithmetic, scaled by a power of two,
-  /// with an error bound: the second stage of the normal predicates. Computed on first
+  /// Facet f's exact normal (the given one, or Newell's of the double points) in
+  /// double-double arithmetic, scaled by a power of two, with an error bound: the second
+  /// stage of the normal predicates. Computed on first
   /// use and kept, as exact_normal.
   const PreciseNormal& precise_normal(int f) const;
 
