@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -194,4 +195,50 @@ TEST_CASE("halfspace_intersection: empty and flat intersections") {
   const MaybePolytope r = checked(cube_planes(1.0), {5, 5, 5});
   REQUIRE(r.polytope);
   CHECK(r.polytope->num_vertices() == 8);
+}
+
+// An opening rounds sums of an erosion's exact vertices X / W and double points b as
+// round_quotient(X + b W, W): it must give mpfr's rounding of the rational sum, also for
+// sums that cancel to (nearly) zero, ties, subnormals and a poor or wrong estimate.
+TEST_CASE("halfspace_intersection: exact vertices plus doubles round as their rational sums") {
+  const auto rounds_exactly = [](const ExactN& X, const ExactN& W, double estimate) {
+    const double want = round_to_nearest(Exact(X) / Exact(W));
+    const double got = round_quotient(X, W, Interval(estimate));
+    return std::memcmp(&got, &want, sizeof got) == 0;  // also tells 0 from -0
+  };
+  const V3<Exact> apex{Exact(1) / Exact(3), Exact(1) / Exact(5), Exact(1) / Exact(7)};
+  std::vector<HalfSpace> hs = cube_planes(2.0);
+  for (int i = 0; i < 12; ++i) {
+    const double t = 2 * M_PI * i / 12;
+    const V3<double> n{std::cos(t), std::sin(t), 0.75};
+    hs.push_back(
+        make_halfspace(to_exact_n(n), dot(to_exact(n), apex), static_cast<int>(hs.size())));
+  }
+  const MaybePolytope r = checked(hs);
+  REQUIRE(r.polytope);
+  const Polytope& p = *r.polytope;
+  REQUIRE(!p.exact_points.empty());
+  for (int v = 0; v < p.num_vertices(); ++v) {
+    const ExactN& W = p.exact_points.denominator[v];
+    const ExactN coordinates[3] = {p.exact_points.numerator[v].x, p.exact_points.numerator[v].y,
+                                   p.exact_points.numerator[v].z};
+    const double rounded[3] = {p.points[v].x, p.points[v].y, p.points[v].z};
+    for (int i = 0; i < 3; ++i) {
+      const double x = rounded[i];
+      for (const double b : {0.0, 1.0, -0.25, 1e300, 0x1p-1070, -x, -x + 0x1p-60,
+                             -x * (1 + 0x1p-52), std::nextafter(-x, 0.0)}) {
+        const ExactN X = coordinates[i] + ExactN(b) * W;
+        CHECK(rounds_exactly(X, W, x + b));
+        CHECK(rounds_exactly(X, W, 0.0));  // a wrong estimate
+        CHECK(rounds_exactly(X, W, -1e200));
+      }
+    }
+  }
+  // Ties go to even, both ways; exact zero is +0.
+  for (const double x : {1.0, 3.0, -5.0, 0x1p-1000}) {
+    const double half_ulp = (std::nextafter(x, HUGE_VAL) - x) / 2;
+    CHECK(rounds_exactly(ExactN(x) + ExactN(half_ulp), ExactN(1), x));
+    CHECK(rounds_exactly((ExactN(x) - ExactN(half_ulp)) * ExactN(3), ExactN(3), x));
+  }
+  CHECK(rounds_exactly(ExactN(0.0), ExactN(7.0), 0.0));
 }

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "../libmorph/src/halfspace_intersection.h"
 #include "../libmorph/src/polytope.h"
 #include "support/polytopes.h"
 
@@ -104,4 +105,30 @@ TEST_CASE(
       CHECK(tally.tiny > 0);
     }
   }
+}
+
+// An erosion's facets carry given exact normals (exact points): their double-double stage
+// splits those normals, and must agree with exact evaluation against the element's
+// normals, which are nearly parallel to them (A and B are fine spheres).
+TEST_CASE("normal predicates: the double-double stage on an erosion's given normals") {
+  const Polytope A = morph::detail::make_operand(sample("icosphere_1280.off"), "A");
+  const Polytope B =
+      morph::detail::make_operand(morph::test::scaled(sample("icosphere_320.off"), 0.25), "B");
+  const morph::detail::MaybePolytope e = morph::detail::erode_polytope(A, B);
+  REQUIRE(e.polytope);
+  const Polytope& E = *e.polytope;
+  REQUIRE(!E.exact_points.empty());
+  for (int f = 0; f < E.num_faces(); ++f) {
+    const auto& n = E.precise_normal(f);
+    REQUIRE(n.valid);
+    // The split is tight: each error is far below the double-double's precision.
+    for (int i = 0; i < 3; ++i) CHECK(n.error[i] <= 0x1p-100);
+  }
+  Tally tally;
+  check_near_triples(E, B, 6, tally);
+  check_near_triples(B, E, 6, tally);
+  check_near_triples(E, E, 6, tally);
+  MESSAGE("erosion: " << tally.triples << " triples, " << tally.zero << " exactly coplanar, "
+                      << tally.tiny << " nonzero below the double filter");
+  CHECK(tally.triples > 0);
 }

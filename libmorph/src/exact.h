@@ -94,4 +94,9 @@ inline V3<Interval> to_interval(const V3<Exact>& p) {
 /// Rounds an exact rational to the nearest double (ties to even).
 double round_to_nearest(const Exact& q);
 
+/// X / W (W > 0) rounded to the nearest double, ties to even, as round_to_nearest(X / W)
+/// but without rationals; `estimate` (any interval near X / W, not necessarily an
+/// enclosure) is where the search starts.
+double round_quotient(const ExactN& X, const ExactN& W, const Interval& estimate);
+
 }  // namespace morph::detail

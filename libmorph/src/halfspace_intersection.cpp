@@ -229,10 +229,11 @@ int det_sign(const Plane& a, const Plane& b, const Plane& c) {
   return s != 2 ? s : CGAL::sign(det(a.n, b.n, c.n));
 }
 
-/// X / W (W > 0) rounded to the nearest double, ties to even: a double within an ulp or
-/// two of it, moved until X / W lies between the midpoints to its neighbours (exact
-/// comparisons in Mpzf, no rational and no gcd). The same value as mpfr's
-/// round_to_nearest(X / W), which is used when the estimate is poor or out of range.
+}  // namespace
+
+// A double within an ulp or two of X / W, moved until X / W lies between the midpoints to
+// its neighbours (exact comparisons in Mpzf, no rational and no gcd). The same value as
+// mpfr's round_to_nearest(X / W), which is used when the estimate is poor or out of range.
 double round_quotient(const ExactN& X, const ExactN& W, const Interval& estimate) {
   constexpr double kNormalRange = 0x1p1000;  // far from overflow and from subnormals
   constexpr int kMaxSteps = 4;               // ulps from the estimate before giving up
@@ -241,25 +242,32 @@ double round_quotient(const ExactN& X, const ExactN& W, const Interval& estimate
   if (!(estimate.sup() - estimate.inf() <= std::abs(r) * 0x1p-50))
     r = X.to_double() / W.to_double();
   if (!(std::abs(r) < kNormalRange && std::abs(r) > 1 / kNormalRange)) return exactly();
-  const ExactN half(0.5);
-  // Sign of X / W - (a + b) / 2.
-  const auto versus_midpoint = [&](double a, double b) {
-    return CGAL::sign(X - (ExactN(a) + ExactN(b)) * half * W);
-  };
   const auto even = [](double a, double b) {
     std::uint64_t bits;
     std::memcpy(&bits, &a, sizeof bits);
     return (bits & 1) == 0 ? a : b;
   };
+  const Interval Wi(W.to_interval());
+  RoundingGuard guard;  // for the interval filter; the rest does not depend on the mode
   for (int step = 0; step < kMaxSteps; ++step) {
     const double up = std::nextafter(r, HUGE_VAL), down = std::nextafter(r, -HUGE_VAL);
-    const int above = versus_midpoint(r, up);
+    // X / W - (r + n) / 2 = (2 R - (n - r) W) / 2W with the residual R = X - r W (one exact
+    // product per step) and n - r exact (neighbouring doubles): its sign, decided in
+    // intervals unless X / W is within rounding of the midpoint.
+    const ExactN R = X - ExactN(r) * W;
+    const Interval Ri(R.to_interval());
+    const auto versus_midpoint = [&](double n) {
+      const double gap = n - r;
+      const int s = interval_sign(Ri + Ri - Interval(gap) * Wi);
+      return s != 2 ? s : CGAL::sign(R + R - ExactN(gap) * W);
+    };
+    const int above = versus_midpoint(up);
     if (above > 0) {
       r = up;
       continue;
     }
     if (above == 0) return even(r, up);
-    const int below = versus_midpoint(down, r);
+    const int below = versus_midpoint(down);
     if (below < 0) {
       r = down;
       continue;
@@ -269,6 +277,8 @@ double round_quotient(const ExactN& X, const ExactN& W, const Interval& estimate
   }
   return exactly();
 }
+
+namespace {
 
 /// Whether the facet cycle `cyc` runs clockwise about `normal` (interval Newell normal of
 /// the vertices, rationals when that cannot decide).
@@ -513,15 +523,17 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   MaybePolytope out;
   RoundedPolytope& rp = out.rounded;
   rp.points.resize(nv);
-  std::vector<V3<Exact>> exact(with_polytope ? nv : 0);
+  ExactPoints exact;
+  if (with_polytope) exact.resize(nv);
   parallel_chunks(nv, 128, [&](int begin, int end) {
     for (int r = begin; r < end; ++r) {
       const HVertex& v = vertex[order[r]];
       rp.points[r] = {round_quotient(v.X.x, v.W, v.xi.x), round_quotient(v.X.y, v.W, v.xi.y),
                       round_quotient(v.X.z, v.W, v.xi.z)};
       if (!with_polytope) continue;
-      const Exact w(v.W);
-      exact[r] = {Exact(v.X.x) / w, Exact(v.X.y) / w, Exact(v.X.z) / w};
+      exact.numerator[r] = v.X;
+      exact.denominator[r] = v.W;
+      exact.enclosure[r] = v.xi;
     }
   });
   rp.face_begin.assign(1, 0);

@@ -238,6 +238,36 @@ void index_vertices(const SumFacets& facets, int num_a, int num_b,
   }
 }
 
+/// A vertex of a polytope in homogeneous dyadic coordinates (X, W) with an estimate of X / W.
+struct Homogeneous {
+  V3<ExactN> X;
+  ExactN W;
+  V3<double> estimate;
+};
+Homogeneous homogeneous(const Polytope& p, int v) {
+  if (p.exact_points.empty()) return {to_exact_n(p.points[v]), ExactN(1), p.points[v]};
+  return {p.exact_points.numerator[v], p.exact_points.denominator[v], p.points[v]};
+}
+
+/// A(i) + B(j) rounded to the nearest doubles, when a point is exact: homogeneous sums
+/// rounded by round_quotient, no rationals (the same values as rounding the rational sum).
+V3<double> round_exact_sum(const Polytope& A, int i, const Polytope& B, int j) {
+  const Homogeneous a = homogeneous(A, i), b = homogeneous(B, j);
+  // a.X / a.W + b.X / b.W; a double point has W = 1, and needs no multiplication by it.
+  const auto sum = [&](const ExactN& x, const ExactN& y) -> ExactN {
+    if (B.exact_points.empty()) return x + y * a.W;
+    if (A.exact_points.empty()) return x * b.W + y;
+    return x * b.W + y * a.W;
+  };
+  const ExactN W = A.exact_points.empty() ? b.W : B.exact_points.empty() ? a.W : a.W * b.W;
+  // Only a starting point for the search: rounded sums of the rounded points.
+  const V3<double> e{a.estimate.x + b.estimate.x, a.estimate.y + b.estimate.y,
+                     a.estimate.z + b.estimate.z};
+  return {round_quotient(sum(a.X.x, b.X.x), W, Interval(e.x)),
+          round_quotient(sum(a.X.y, b.X.y), W, Interval(e.y)),
+          round_quotient(sum(a.X.z, b.X.z), W, Interval(e.z))};
+}
+
 }  // namespace
 
 LabelledMesh sum_mesh(const Polytope& A, const Polytope& B, const SumFacets& facets) {
@@ -254,8 +284,7 @@ LabelledMesh sum_mesh(const Polytope& A, const Polytope& B, const SumFacets& fac
         const auto& b = B.points[j];
         points[v] = {a.x + b.x, a.y + b.y, a.z + b.z};
       } else {
-        const V3<Exact> s = A.exact_point(i) + B.exact_point(j);
-        points[v] = {round_to_nearest(s.x), round_to_nearest(s.y), round_to_nearest(s.z)};
+        points[v] = round_exact_sum(A, i, B, j);
       }
     }
   });
@@ -274,14 +303,21 @@ Polytope sum_polytope(const Polytope& A, const Polytope& B, const SumFacets& fac
   std::vector<int> corners;
   index_vertices(facets, A.num_vertices(), B.num_vertices(), pairs, corners);
   std::vector<V3<double>> points(pairs.size());
-  std::vector<V3<Exact>> exact(pairs.size());
-  for (std::size_t v = 0; v < pairs.size(); ++v) {
-    exact[v] = A.exact_point(pair_first(pairs[v])) + B.exact_point(pair_second(pairs[v]));
-    points[v] = {round_to_nearest(exact[v].x), round_to_nearest(exact[v].y),
-                 round_to_nearest(exact[v].z)};
-  }
   if (!A.exact_points.empty() || !B.exact_points.empty())
     throw error("internal error: an exact sum needs operands with double points");
+  // Sums of doubles are dyadic: exact with denominator 1.
+  ExactPoints exact;
+  exact.resize(pairs.size());
+  for (std::size_t v = 0; v < pairs.size(); ++v) {
+    const V3<double>&a = A.points[pair_first(pairs[v])], &b = B.points[pair_second(pairs[v])];
+    const V3<ExactN> x = to_exact_n(a) + to_exact_n(b);
+    exact.numerator[v] = x;
+    exact.denominator[v] = ExactN(1);
+    exact.enclosure[v] = {Interval(x.x.to_interval()), Interval(x.y.to_interval()),
+                          Interval(x.z.to_interval())};
+    points[v] = {round_to_nearest(Exact(x.x)), round_to_nearest(Exact(x.y)),
+                 round_to_nearest(Exact(x.z))};
+  }
   std::vector<std::vector<int>> faces(facets.num_faces());
   std::vector<V3<ExactN>> normals(facets.num_faces());
   std::vector<V3<ExactN>> cycle;

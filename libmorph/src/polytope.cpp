@@ -154,6 +154,34 @@ PreciseNormal precise_newell(const std::vector<V3<double>>& points, const int* c
   return n;
 }
 
+/// The precise normal of a facet with a given exact normal (exact points): the components
+/// scaled by one power of two (exactly) so that the largest is about 1, each split into a
+/// double-double whose distance to it, an exact remainder, is enclosed for its error.
+/// Needs round-to-nearest, as the double-double stage that uses it.
+PreciseNormal precise_given(const V3<ExactN>& normal) {
+  PreciseNormal n{};
+  const ExactN* components[3] = {&normal.x, &normal.y, &normal.z};
+  double largest = 0;
+  for (const ExactN* c : components) largest = std::max(largest, std::abs(c->to_double()));
+  if (!(largest > 0) || !std::isfinite(largest)) return n;
+  const int shift = -std::ilogb(largest);
+  if (std::abs(shift) > 900) return n;  // the scale must be a double
+  const ExactN scale(std::ldexp(1.0, shift));
+  for (int i = 0; i < 3; ++i) {
+    const ExactN x = *components[i] * scale;
+    if (CGAL::sign(x) == CGAL::ZERO) continue;  // exactly zero: hi = lo = error = 0
+    const double hi = x.to_double();            // within an ulp, not necessarily nearest
+    const DD s = quick_two_sum(hi, (x - ExactN(hi)).to_double());
+    // Mpzf's enclosure is built from its limbs, whatever the rounding mode.
+    const std::pair<double, double> rest = (x - ExactN(s.hi) - ExactN(s.lo)).to_interval();
+    n.hi[i] = s.hi;
+    n.lo[i] = s.lo;
+    n.error[i] = std::max(std::abs(rest.first), std::abs(rest.second));
+  }
+  n.valid = true;
+  return n;
+}
+
 /// Upper bound on the Euclidean length of a precise normal (the sum of |components|).
 double length_bound(const PreciseNormal& n) {
   return (std::abs(n.hi[0]) + std::abs(n.hi[1]) + std::abs(n.hi[2])) * (1 + 1e-15) + n.error[0] +
@@ -167,7 +195,7 @@ double error_bound(const PreciseNormal& n) { return n.error[0] + n.error[1] + n.
 
 const PreciseNormal& Polytope::precise_normal(int f) const {
   return precise_cache_->get(f, [&] {
-    if (!exact_points.empty()) return PreciseNormal{};
+    if (!given_normals.empty()) return precise_given(given_normals[f]);
     return precise_newell(points, &corner_vertex[face_begin[f]], degree(f));
   });
 }
@@ -404,8 +432,14 @@ int edge_convexity(const Polytope& p, const Polytope::Edge& e) {
   if (p.exact_points.empty())
     return CGAL::sign(det(p.exact_normal(e.left), p.exact_normal(e.right),
                           to_exact_n(p.points[e.to]) - to_exact_n(p.points[e.from])));
-  return CGAL::sign(det(to_rational(p.exact_normal(e.left)), to_rational(p.exact_normal(e.right)),
-                        p.exact_point(e.to) - p.exact_point(e.from)));
+  // X_to / W_to - X_from / W_from has the direction of X_to W_from - X_from W_to (W > 0):
+  // dyadic, no rationals.
+  const ExactPoints& x = p.exact_points;
+  const ExactN &w_to = x.denominator[e.to], &w_from = x.denominator[e.from];
+  const V3<ExactN>&a = x.numerator[e.to], &b = x.numerator[e.from];
+  const V3<ExactN> direction{a.x * w_from - b.x * w_to, a.y * w_from - b.y * w_to,
+                             a.z * w_from - b.z * w_to};
+  return CGAL::sign(det(p.exact_normal(e.left), p.exact_normal(e.right), direction));
 }
 
 /// The Gauss map must be valid: the normals around every vertex turn strictly
@@ -551,7 +585,7 @@ bool has_deleted_elements(const Mesh& mesh) {
 
 }  // namespace
 
-Polytope make_polytope(std::vector<V3<double>> points, std::vector<V3<Exact>> exact_points,
+Polytope make_polytope(std::vector<V3<double>> points, ExactPoints exact_points,
                        const std::vector<std::vector<int>>& input_faces,
                        std::vector<V3<ExactN>> given_normals, const char* name) {
   if (!exact_points.empty() && given_normals.size() != input_faces.size())
@@ -656,12 +690,18 @@ Polytope make_polytope(std::vector<V3<double>> points, std::vector<V3<Exact>> ex
       if (new_index[v] < 0) new_index[v] = used++;
   if (used != p.num_vertices()) {
     std::vector<V3<double>> pts(used);
-    std::vector<V3<Exact>> epts(p.exact_points.empty() ? 0 : used);
+    const bool exact = !p.exact_points.empty();
+    ExactPoints epts;
+    if (exact) epts.resize(used);
     std::vector<int> vsrc(used);
     for (int v = 0; v < p.num_vertices(); ++v) {
       if (new_index[v] < 0) continue;
       pts[new_index[v]] = p.points[v];
-      if (!epts.empty()) epts[new_index[v]] = p.exact_points[v];
+      if (exact) {
+        epts.numerator[new_index[v]] = p.exact_points.numerator[v];
+        epts.denominator[new_index[v]] = p.exact_points.denominator[v];
+        epts.enclosure[new_index[v]] = p.exact_points.enclosure[v];
+      }
       vsrc[new_index[v]] = v;
     }
     for (auto& cyc : faces)

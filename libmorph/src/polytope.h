@@ -35,13 +35,33 @@ struct UnitNormal {
 
 /// A facet normal in double-double arithmetic (component i is hi[i] + lo[i]), times some
 /// power of two, within error[i] of the exact normal times that power in component i (a
-/// component that is exactly zero has error 0). Not `valid` when the facet's points are
-/// not doubles or do not scale exactly.
+/// component that is exactly zero has error 0). Not `valid` when the facet's points (or
+/// its given normal) do not scale exactly.
 struct PreciseNormal {
   double hi[3], lo[3];
   double error[3];
   bool valid;
   bool exactly_zero(int i) const { return error[i] == 0 && hi[i] == 0; }
+};
+
+/// Exact vertex positions that are not doubles (an erosion's vertices), in homogeneous
+/// dyadic coordinates: vertex v is numerator[v] / denominator[v] (denominator > 0), within
+/// the interval box enclosure[v]. Rationals would cost three gcds per vertex to build and
+/// more to add; these are exactly what the intersection computed.
+struct ExactPoints {
+  std::vector<V3<ExactN>> numerator;
+  std::vector<ExactN> denominator;
+  std::vector<V3<Interval>> enclosure;
+  bool empty() const { return denominator.empty(); }
+  void resize(std::size_t n) {
+    numerator.resize(n);
+    denominator.resize(n);
+    enclosure.resize(n);
+  }
+  V3<Exact> rational(int v) const {
+    const Exact w(denominator[v]);
+    return {Exact(numerator[v].x) / w, Exact(numerator[v].y) / w, Exact(numerator[v].z) / w};
+  }
 };
 
 struct Polytope {
@@ -52,7 +72,7 @@ struct Polytope {
 
   // Vertices: rounded positions, and exact ones when they are not doubles.
   std::vector<V3<double>> points;
-  std::vector<V3<Exact>> exact_points;  // empty when `points` are exact
+  ExactPoints exact_points;  // empty when `points` are exact
   // Exact facet normals when `exact_points` is used (the normal of the plane the facet was
   // built on); empty otherwise, the normals being Newell's of the double points.
   std::vector<V3<ExactN>> given_normals;
@@ -87,10 +107,10 @@ struct Polytope {
   int corner(int f, int k) const { return corner_vertex[face_begin[f] + k]; }
 
   V3<Exact> exact_point(int v) const {
-    return exact_points.empty() ? to_exact(points[v]) : exact_points[v];
+    return exact_points.empty() ? to_exact(points[v]) : exact_points.rational(v);
   }
   V3<Interval> interval_point(int v) const {
-    return exact_points.empty() ? to_interval(points[v]) : to_interval(exact_points[v]);
+    return exact_points.empty() ? to_interval(points[v]) : exact_points.enclosure[v];
   }
 
   /// Exact normal of facet f: given, or Newell's of its points, computed on first use and
@@ -101,8 +121,9 @@ struct Polytope {
   /// normals; call after the facets are final.
   void compute_normals();
 
-  /// Newell's normal of facet f in double-double arithmetic, scaled by a power of two,
-  /// with an error bound: the second stage of the normal predicates. Computed on first
+  /// Facet f's exact normal (the given one, or Newell's of the double points) in
+  /// double-double arithmetic, scaled by a power of two, with an error bound: the second
+  /// stage of the normal predicates. Computed on first
   /// use and kept, as exact_normal.
   const PreciseNormal& precise_normal(int f) const;
 
@@ -207,7 +228,7 @@ Polytope make_polytope_from_cycles(const Mesh& mesh, const char* name,
 /// Builds a polytope from facet cycles over the given vertices (exact positions when
 /// `exact_points` is non-empty, and then one exact normal per facet in `given_normals`),
 /// canonicalising it as make_polytope does. Vertices not used by any facet are dropped.
-Polytope make_polytope(std::vector<V3<double>> points, std::vector<V3<Exact>> exact_points,
+Polytope make_polytope(std::vector<V3<double>> points, ExactPoints exact_points,
                        const std::vector<std::vector<int>>& faces,
                        std::vector<V3<ExactN>> given_normals, const char* name);
 
