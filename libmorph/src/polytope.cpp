@@ -241,7 +241,7 @@ void Polytope::compute_normals() {
   precise_cache_ = std::make_shared<LazySlots<PreciseNormal>>(nf);
 }
 
-int orient_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
+int orient_normals_undecided(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
   {
     // Double-double needs round-to-nearest, whatever the caller set.
     CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
@@ -277,7 +277,7 @@ int orient_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef
   return CGAL::sign(det(a.exact(), b.exact(), c.exact()));
 }
 
-int cross_dot_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef& c,
+int cross_dot_normals_undecided(const NormalRef& a, const NormalRef& b, const NormalRef& c,
                             const NormalRef& d) {
   return CGAL::sign(cross_dot(a.exact(), b.exact(), c.exact(), d.exact()));
 }

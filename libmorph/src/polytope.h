@@ -175,9 +175,11 @@ struct NormalRef {
 /// ulp): about 7e-15, doubled for safety.
 inline constexpr double kUnitPredicateRounding = 2e-14;
 
-int orient_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef& c);
-int cross_dot_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef& c,
-                            const NormalRef& d);
+/// The later stages, for what the double filter leaves undecided: double-double, then
+/// exact (orient); exact (cross_dot).
+int orient_normals_undecided(const NormalRef& a, const NormalRef& b, const NormalRef& c);
+int cross_dot_normals_undecided(const NormalRef& a, const NormalRef& b, const NormalRef& c,
+                                const NormalRef& d);
 
 /// Sign of det(N_a, N_b, N_c).
 inline int orient_normals(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
@@ -188,7 +190,7 @@ inline int orient_normals(const NormalRef& a, const NormalRef& b, const NormalRe
   const double bound = p.error + q.error + r.error + kUnitPredicateRounding;
   if (d > bound) return 1;
   if (d < -bound) return -1;
-  return orient_normals_exact(a, b, c);
+  return orient_normals_undecided(a, b, c);
 }
 
 /// Sign of (N_a x N_b) . (N_c x N_d) = (N_a.N_c)(N_b.N_d) - (N_a.N_d)(N_b.N_c).
@@ -204,7 +206,7 @@ inline int cross_dot_normals(const NormalRef& a, const NormalRef& b, const Norma
   const double bound = 2 * e + 4 * e * e + kUnitPredicateRounding;
   if (value > bound) return 1;
   if (value < -bound) return -1;
-  return cross_dot_normals_exact(a, b, c, d);
+  return cross_dot_normals_undecided(a, b, c, d);
 }
 
 /// How make_polytope reads a mesh's faces: as given, or each reversed (an inverted mesh,
