@@ -315,21 +315,17 @@ Polytope sum_polytope(const Polytope& A, const Polytope& B, const SumFacets& fac
     exact.denominator[v] = ExactN(1);
     exact.enclosure[v] = {Interval(x.x.to_interval()), Interval(x.y.to_interval()),
                           Interval(x.z.to_interval())};
-    points[v] = {round_to_nearest(Exact(x.x)), round_to_nearest(Exact(x.y)),
-                 round_to_nearest(Exact(x.z))};
+    points[v] = {a.x + b.x, a.y + b.y, a.z + b.z};  // correctly rounded, as in sum_mesh
   }
   std::vector<std::vector<int>> faces(facets.num_faces());
   std::vector<V3<ExactN>> normals(facets.num_faces());
-  std::vector<V3<ExactN>> cycle;
   for (int f = 0; f < facets.num_faces(); ++f) {
     faces[f].assign(corners.begin() + facets.face_begin[f],
                     corners.begin() + facets.face_begin[f + 1]);
-    cycle.clear();
-    for (int c = facets.face_begin[f]; c < facets.face_begin[f + 1]; ++c)
-      cycle.push_back(to_exact_n(A.points[pair_first(facets.corners[c])]) +
-                      to_exact_n(B.points[pair_second(facets.corners[c])]));
-    normals[f] = newell_normal<ExactN>(static_cast<int>(cycle.size()),
-                                       [&](int i) -> const V3<ExactN>& { return cycle[i]; });
+    const std::vector<int>& cycle = faces[f];
+    normals[f] = newell_normal<ExactN>(
+        static_cast<int>(cycle.size()),
+        [&](int i) -> const V3<ExactN>& { return exact.numerator[cycle[i]]; });
   }
   return make_polytope(std::move(points), std::move(exact), faces, std::move(normals), "A (+) B");
 }
