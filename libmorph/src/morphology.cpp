@@ -10,11 +10,8 @@ namespace morph {
 
 namespace {
 
-using detail::Polytope;
-
 using detail::Operands;
-
-Operands prepare(const Mesh& A, const Mesh& B) { return detail::make_operands(A, B); }
+using detail::Polytope;
 
 MorphResult empty_result(const detail::MaybePolytope& m) {
   MorphResult r;
@@ -57,14 +54,14 @@ constexpr detail::IntersectOptions kFinal{.polytope = false};
 
 MorphResult dilate(const Mesh& A, const Mesh& B, const MorphologyOptions& options) {
   return detail::run_with_threads(options.threads, [&] {
-    const Operands op = prepare(A, B);
+    const Operands op = detail::make_operands(A, B);
     return from_sum(op.a, op.b);
   });
 }
 
 MorphResult erode(const Mesh& A, const Mesh& B, const MorphologyOptions& options) {
   return detail::run_with_threads(options.threads, [&] {
-    const Operands op = prepare(A, B);
+    const Operands op = detail::make_operands(A, B);
     const detail::MaybePolytope e = detail::erode_polytope(op.a, op.b, kFinal);
     if (e.reason != EmptyReason::none) return empty_result(e);
     return from_rounded(e.rounded, [&](int f) { return erosion_origin(e.rounded, f); });
@@ -73,7 +70,7 @@ MorphResult erode(const Mesh& A, const Mesh& B, const MorphologyOptions& options
 
 MorphResult open(const Mesh& A, const Mesh& B, const MorphologyOptions& options) {
   return detail::run_with_threads(options.threads, [&] {
-    const Operands op = prepare(A, B);
+    const Operands op = detail::make_operands(A, B);
     const detail::MaybePolytope e = detail::erode_polytope(op.a, op.b);
     return e.polytope ? from_sum(*e.polytope, op.b) : empty_result(e);
   });
@@ -81,7 +78,7 @@ MorphResult open(const Mesh& A, const Mesh& B, const MorphologyOptions& options)
 
 MorphResult close(const Mesh& A, const Mesh& B, const MorphologyOptions& options) {
   return detail::run_with_threads(options.threads, [&] {
-    const Operands op = prepare(A, B);
+    const Operands op = detail::make_operands(A, B);
     const detail::SumFacets sum = detail::fims_facets(op.a, op.b);
     const Polytope s = detail::sum_polytope(op.a, op.b, sum);
     const detail::MaybePolytope e = detail::erode_polytope(s, op.b, kFinal);
