@@ -123,8 +123,7 @@ struct Polytope {
 
   /// Facet f's exact normal (the given one, or Newell's of the double points) in
   /// double-double arithmetic, scaled by a power of two, with an error bound: the second
-  /// stage of the normal predicates. Computed on first
-  /// use and kept, as exact_normal.
+  /// stage of the normal predicates. Computed on first use and kept, as exact_normal.
   const PreciseNormal& precise_normal(int f) const;
 
  private:
