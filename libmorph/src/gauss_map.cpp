@@ -116,6 +116,9 @@ ArcContact arc_contact(const NormalRef& n1, const NormalRef& n2, const NormalRef
     c.touches = between(n1, m1, n2) || between(n1, m2, n2) || between(m1, n1, m2);
     return c;
   }
+  // Both ends strictly on one side of n's great circle: so is all of m, which then
+  // shares no point with n (nor with its great circle).
+  if (s1 * s2 > 0) return c;
   const int t1 = orient(m1, m2, n1), t2 = orient(m1, m2, n2);
   if (s1 * s2 < 0 && t1 * t2 < 0) {
     // The great circles meet at +-X; the arcs share X (not -X) iff t1 == -s1.
