@@ -24,6 +24,7 @@ using morph::detail::Polytope;
 
 struct Tally {
   int triples = 0, zero = 0, tiny = 0;  // tiny: |det| of the unit normals below 1e-13
+  int tiny_cross = 0;                   // the same for (a x b) . (a x c)
 };
 
 /// For each facet of A, the `near` facets of B with the closest normals; every triple of
@@ -48,12 +49,17 @@ void check_near_triples(const Polytope& A, const Polytope& B, int near, Tally& t
         const int exact_cross =
             CGAL::sign(morph::detail::cross_dot(a.exact(), b.exact(), a.exact(), c.exact()));
         CHECK(morph::detail::cross_dot_normals(a, b, a, c) == exact_cross);
+        CHECK(morph::detail::cross_dot_normals(b, c, a, c) ==
+              CGAL::sign(morph::detail::cross_dot(b.exact(), c.exact(), a.exact(), c.exact())));
         ++tally.triples;
         tally.zero += exact == 0;
         const auto &p = a.unit(), &q = b.unit(), &r = c.unit();
         const double d = p.x * (q.y * r.z - q.z * r.y) + p.y * (q.z * r.x - q.x * r.z) +
                          p.z * (q.x * r.y - q.y * r.x);
         tally.tiny += exact != 0 && std::abs(d) < 1e-13;
+        auto dot = [](const auto& u, const auto& w) { return u.x * w.x + u.y * w.y + u.z * w.z; };
+        const double cd = dot(p, p) * dot(q, r) - dot(p, r) * dot(q, p);
+        tally.tiny_cross += exact_cross != 0 && std::abs(cd) < 1e-13;
       }
   }
 }
@@ -98,11 +104,13 @@ TEST_CASE(
     Tally tally;
     check_near_triples(A, B, 6, tally);
     MESSAGE(pair.what << ": " << tally.triples << " triples, " << tally.zero
-                      << " exactly coplanar, " << tally.tiny << " nonzero below the double filter");
+                      << " exactly coplanar, " << tally.tiny << " nonzero below the double filter ("
+                      << tally.tiny_cross << " of cross_dot)");
     CHECK(tally.triples > 0);
     if (pair.degenerate) {
       CHECK(tally.zero > 0);
       CHECK(tally.tiny > 0);
+      CHECK(tally.tiny_cross > 0);
     }
   }
 }

@@ -279,6 +279,44 @@ int orient_normals_undecided(const NormalRef& a, const NormalRef& b, const Norma
 
 int cross_dot_normals_undecided(const NormalRef& a, const NormalRef& b, const NormalRef& c,
                             const NormalRef& d) {
+  {
+    // As orient_normals_undecided: double-double on precise normals (nearly parallel
+    // normals give values far below what doubles resolve), in round-to-nearest.
+    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    const PreciseNormal& p = a.polytope->precise_normal(a.face);
+    const PreciseNormal& q = b.polytope->precise_normal(b.face);
+    const PreciseNormal& r = c.polytope->precise_normal(c.face);
+    const PreciseNormal& s = d.polytope->precise_normal(d.face);
+    if (p.valid && q.valid && r.valid && s.valid) {
+      auto dd = [](const PreciseNormal& n, int i) { return DD{n.hi[i], n.lo[i]}; };
+      auto dot_dd = [&](const PreciseNormal& u, const PreciseNormal& v) {
+        return dd(u, 0) * dd(v, 0) + dd(u, 1) * dd(v, 1) + dd(u, 2) * dd(v, 2);
+      };
+      auto dot_abs = [](const PreciseNormal& u, const PreciseNormal& v) {
+        return std::abs(u.hi[0] * v.hi[0]) + std::abs(u.hi[1] * v.hi[1]) +
+               std::abs(u.hi[2] * v.hi[2]);
+      };
+      const DD value = dot_dd(p, r) * dot_dd(q, s) - dot_dd(p, s) * dot_dd(q, r);
+      // The evaluation: three levels of operations on terms bounded by the permanent
+      // (each dot errs by 12 u^2 of its magnitude, each product of dots by 28, the
+      // difference by 4 more: 32, doubled as in orient).
+      const double permanent = dot_abs(p, r) * dot_abs(q, s) + dot_abs(p, s) * dot_abs(q, r);
+      // The inputs: the value is multilinear, each of its two terms at most the product
+      // of the four lengths, so replacing x by x' = x + dx moves it by at most
+      // 2 |dx| times the other three lengths (each bound both exact and approximate).
+      const double lp = length_bound(p), lq = length_bound(q), lr = length_bound(r),
+                   ls = length_bound(s);
+      const double dp = error_bound(p), dq = error_bound(q), dr = error_bound(r),
+                   ds = error_bound(s);
+      const double bound =
+          (2 * (dp * lq * lr * ls + lp * dq * lr * ls + lp * lq * dr * ls + lp * lq * lr * ds) +
+           64 * kU2 * permanent * 1.1) *
+              1.01 +
+          0x1p-1000;
+      if (value.hi > bound) return 1;
+      if (value.hi < -bound) return -1;
+    }
+  }
   return CGAL::sign(cross_dot(a.exact(), b.exact(), c.exact(), d.exact()));
 }
 

@@ -164,7 +164,7 @@ struct NormalRef {
 // Predicates on facet normals, the decisions of the FIMS kernel. Each is a semi-static
 // filter: evaluated in doubles on the unit normals, whose error bounds (plus the rounding
 // of the evaluation itself, in any rounding mode) bound the error of the value. When that
-// cannot decide the sign, orient tries again in double-double arithmetic on precise
+// cannot decide the sign, each tries again in double-double arithmetic on precise
 // normals (nearly parallel facets of two fine spheres need it), and only then evaluates
 // exactly on the exact normals. Signs are those of the exact normals (positive scalings
 // do not change them).
@@ -175,7 +175,7 @@ struct NormalRef {
 inline constexpr double kUnitPredicateRounding = 2e-14;
 
 /// The later stages, for what the double filter leaves undecided: double-double, then
-/// exact (orient); exact (cross_dot).
+/// exact.
 int orient_normals_undecided(const NormalRef& a, const NormalRef& b, const NormalRef& c);
 int cross_dot_normals_undecided(const NormalRef& a, const NormalRef& b, const NormalRef& c,
                                 const NormalRef& d);
