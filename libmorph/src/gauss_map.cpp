@@ -18,12 +18,16 @@ bool between(const NormalRef& p, const NormalRef& x, const NormalRef& q) {
 /// Signs of det(N_fan[i], N_fan[i+1], p) for the slots of v's region, walking on at the
 /// first negative one. Returns the slot to cross, or -1 when p is in the closed region,
 /// with `zeros` holding the slots whose arc contains p.
-int region_test(const Polytope& P, int v, const NormalRef& p, int zeros[2], int& nzeros) {
+int region_test(const Polytope& P, const std::vector<ArcPlane>& planes, int v, const NormalRef& p,
+                int zeros[2], int& nzeros) {
   const int b = P.fan_begin[v], n = P.fan_begin[v + 1] - b;
   nzeros = 0;
   for (int i = 0; i < n; ++i) {
-    const int s = orient(NormalRef{&P, P.fan_face[b + i]},
-                         NormalRef{&P, P.fan_face[b + (i + 1 == n ? 0 : i + 1)]}, p);
+    // Slot i's arc joins fan_face[i] and fan_face[i + 1]: its edge's left and right facets
+    // in either order.
+    const int e = P.fan_edge[b + i];
+    const int t = orient_arc(P, e, planes[e], p);
+    const int s = P.edges[e].left == P.fan_face[b + i] ? t : -t;
     if (s < 0) return i;
     if (s == 0) {
       if (nzeros == 2) throw error("internal error: a direction lies on three arcs of one region");
@@ -45,7 +49,20 @@ Location classify(const Polytope& P, int v, const int zeros[2], int nzeros) {
 
 }  // namespace
 
-Location locate(const Polytope& P, const NormalRef& p, int hint) {
+std::vector<ArcPlane> arc_planes(const Polytope& P) {
+  std::vector<ArcPlane> planes(P.num_edges());
+  parallel_chunks(P.num_edges(), 4096, [&](int begin, int end) {
+    for (int e = begin; e < end; ++e) {
+      const UnitNormal &q = P.unit_normals[P.edges[e].left], &r = P.unit_normals[P.edges[e].right];
+      planes[e] = {q.y * r.z - q.z * r.y, q.z * r.x - q.x * r.z, q.x * r.y - q.y * r.x,
+                   q.error + r.error};
+    }
+  });
+  return planes;
+}
+
+Location locate(const Polytope& P, const std::vector<ArcPlane>& planes, const NormalRef& p,
+                int hint) {
   // First a cheap climb in doubles: to the neighbour with the largest support value
   // <p, x>, while it strictly grows (so it ends). It only picks where the exact walk
   // starts, which then usually finds the region at once.
@@ -73,7 +90,7 @@ Location locate(const Polytope& P, const NormalRef& p, int hint) {
   int nzeros = 0;
   const int limit = P.num_vertices() + 16;
   for (int steps = 0; steps < limit; ++steps) {
-    const int cross = region_test(P, v, p, zeros, nzeros);
+    const int cross = region_test(P, planes, v, p, zeros, nzeros);
     if (cross < 0) return classify(P, v, zeros, nzeros);
     v = P.fan_vertex[P.fan_begin[v] + cross];
   }
@@ -81,7 +98,7 @@ Location locate(const Polytope& P, const NormalRef& p, int hint) {
   // exactly planar; on facets planar only within the tolerance it might, so fall back
   // to testing every region.
   for (v = 0; v < P.num_vertices(); ++v)
-    if (region_test(P, v, p, zeros, nzeros) < 0) return classify(P, v, zeros, nzeros);
+    if (region_test(P, planes, v, p, zeros, nzeros) < 0) return classify(P, v, zeros, nzeros);
   throw error("internal error: a direction lies in no region of the Gauss map");
 }
 
@@ -98,11 +115,16 @@ int location_vertex(const Polytope& P, const Location& loc) {
 }
 
 std::vector<Location> locate_all(const Polytope& from, const Polytope& in) {
+  return locate_all(from, in, arc_planes(in));
+}
+
+std::vector<Location> locate_all(const Polytope& from, const Polytope& in,
+                                 const std::vector<ArcPlane>& in_planes) {
   std::vector<Location> loc(from.num_faces());
   parallel_chunks(from.num_faces(), 256, [&](int begin, int end) {
     int hint = 0;
     for (int f = begin; f < end; ++f) {
-      loc[f] = locate(in, NormalRef{&from, f}, hint);
+      loc[f] = locate(in, in_planes, NormalRef{&from, f}, hint);
       hint = location_vertex(in, loc[f]);
     }
   });
@@ -110,7 +132,7 @@ std::vector<Location> locate_all(const Polytope& from, const Polytope& in) {
 }
 
 ArcContact arc_contact(const NormalRef& n1, const NormalRef& n2, const NormalRef& m1,
-                       const NormalRef& m2, int s1, int s2) {
+                       const NormalRef& m2, int s1, int s2, int t1, int t2) {
   ArcContact c;
   if (s1 == 0 && s2 == 0) {  // on one great circle: touching iff they overlap
     c.touches = between(n1, m1, n2) || between(n1, m2, n2) || between(m1, n1, m2);
@@ -119,7 +141,6 @@ ArcContact arc_contact(const NormalRef& n1, const NormalRef& n2, const NormalRef
   // Both ends strictly on one side of n's great circle: so is all of m, which then
   // shares no point with n (nor with its great circle).
   if (s1 * s2 > 0) return c;
-  const int t1 = orient(m1, m2, n1), t2 = orient(m1, m2, n2);
   if (s1 * s2 < 0 && t1 * t2 < 0) {
     // The great circles meet at +-X; the arcs share X (not -X) iff t1 == -s1.
     if (t1 == -s1) c.touches = c.crosses = true;

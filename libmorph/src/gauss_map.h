@@ -19,12 +19,35 @@ inline int orient(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
   return orient_normals(a, b, c);
 }
 
-/// Locates the direction `p` in P's Gauss map: the vertex whose region contains it in
-/// its interior (the contributing vertex), the edge whose arc contains it, or the facet
-/// whose normal has its direction. The walk starts at vertex `hint`, climbs the support
+/// The plane of an arc of a Gauss map: N_left x N_right of its edge, from the unit normals
+/// in doubles, and the sum of their error bounds. The double stage of
+/// orient(N_left, N_right, x) is then one dot product: det(x, N_left, N_right) expanded
+/// along x, the same operations as orient_normals (hence its bound).
+struct ArcPlane {
+  double x, y, z, error;
+};
+
+/// The planes of all arcs of P's Gauss map, indexed by edge.
+std::vector<ArcPlane> arc_planes(const Polytope& P);
+
+/// Sign of det(N_left, N_right, x) for edge e of P, whose arc's plane is `plane`.
+inline int orient_arc(const Polytope& P, int e, const ArcPlane& plane, const NormalRef& x) {
+  const UnitNormal& u = x.unit();
+  const double d = u.x * plane.x + u.y * plane.y + u.z * plane.z;
+  const double bound = plane.error + u.error + kUnitPredicateRounding;
+  if (d > bound) return 1;
+  if (d < -bound) return -1;
+  return orient_normals_undecided(NormalRef{&P, P.edges[e].left}, NormalRef{&P, P.edges[e].right},
+                                  x);
+}
+
+/// Locates the direction `p` in P's Gauss map (`planes`: its arc_planes): the vertex whose region
+/// contains it in its interior (the contributing vertex), the edge whose arc contains it, or the
+/// facet whose normal has its direction. The walk starts at vertex `hint`, climbs the support
 /// function in doubles (only to choose where to start), then walks exactly from region to
 /// region; the answer is exact and does not depend on the hint. Expected O(distance walked).
-Location locate(const Polytope& P, const NormalRef& p, int hint);
+Location locate(const Polytope& P, const std::vector<ArcPlane>& planes, const NormalRef& p,
+                int hint);
 
 /// A vertex of the feature `loc` (the contributing vertex when it is a vertex region).
 int location_vertex(const Polytope& P, const Location& loc);
@@ -33,6 +56,9 @@ int location_vertex(const Polytope& P, const Location& loc);
 /// starting from the previous facet's answer (facets near in index order are usually
 /// near on the sphere).
 std::vector<Location> locate_all(const Polytope& from, const Polytope& in);
+/// The same with in's arc planes already made.
+std::vector<Location> locate_all(const Polytope& from, const Polytope& in,
+                                 const std::vector<ArcPlane>& in_planes);
 
 /// How the arc (n1, n2) meets the arc (m1, m2) (both shorter than a half circle).
 struct ArcContact {
@@ -41,9 +67,14 @@ struct ArcContact {
   int side = 0;          // when crossing: sign of det(n1, n2, m2) (where m2 lies)
 };
 /// s1 and s2 are orient(n1, n2, m1) and orient(n1, n2, m2), which a caller testing many
-/// arcs against one computes once per normal.
+/// arcs against one computes once per normal; t1 and t2 are orient(m1, m2, n1) and
+/// orient(m1, m2, n2), needed only when s1 * s2 <= 0 and not s1 == s2 == 0 (otherwise
+/// the arcs' contact follows from s1 and s2 alone, and a caller may pass anything).
 ArcContact arc_contact(const NormalRef& n1, const NormalRef& n2, const NormalRef& m1,
-                       const NormalRef& m2, int s1, int s2);
+                       const NormalRef& m2, int s1, int s2, int t1, int t2);
+
+/// Whether arc_contact needs t1 and t2 for these s1 and s2.
+inline bool arc_contact_needs_t(int s1, int s2) { return s1 * s2 <= 0 && (s1 != 0 || s2 != 0); }
 
 /// An arc of a Gauss map leaving a point, toward the normal `to`, followed
 /// counter-clockwise by the region of vertex `after`.

@@ -89,7 +89,8 @@ struct WalkScratch {
 /// outward normal. The crossings are found by a breadth-first walk over the regions of B
 /// that the arc touches, starting where the arc starts; each of B's normals is tested
 /// against the arc's great circle once.
-void edge_facets(const Polytope& A, int a, const Polytope& B, const Location& start, WalkScratch& w,
+void edge_facets(const Polytope& A, int a, const ArcPlane& plane_a, const Polytope& B,
+                 const std::vector<ArcPlane>& planes_b, const Location& start, WalkScratch& w,
                  FacetBuffer& out) {
   const auto& ea = A.edges[a];
   const NormalRef n1{&A, ea.left}, n2{&A, ea.right};
@@ -104,7 +105,7 @@ void edge_facets(const Polytope& A, int a, const Polytope& B, const Location& st
   auto side = [&](int g) {
     if (w.face_stamp[g] != stamp) {
       w.face_stamp[g] = stamp;
-      w.face_side[g] = static_cast<signed char>(orient(n1, n2, NormalRef{&B, g}));
+      w.face_side[g] = static_cast<signed char>(orient_arc(A, a, plane_a, NormalRef{&B, g}));
     }
     return static_cast<int>(w.face_side[g]);
   };
@@ -129,8 +130,15 @@ void edge_facets(const Polytope& A, int a, const Polytope& B, const Location& st
       if (w.edge_stamp[e] == stamp) continue;
       w.edge_stamp[e] = stamp;
       const auto& eb = B.edges[e];
-      const ArcContact c = arc_contact(n1, n2, NormalRef{&B, eb.left}, NormalRef{&B, eb.right},
-                                       side(eb.left), side(eb.right));
+      const int s1 = side(eb.left), s2 = side(eb.right);
+      if (s1 * s2 > 0) continue;  // b's arc strictly on one side of a's great circle
+      int t1 = 0, t2 = 0;
+      if (arc_contact_needs_t(s1, s2)) {
+        t1 = orient_arc(B, e, planes_b[e], n1);
+        t2 = orient_arc(B, e, planes_b[e], n2);
+      }
+      const ArcContact c =
+          arc_contact(n1, n2, NormalRef{&B, eb.left}, NormalRef{&B, eb.right}, s1, s2, t1, t2);
       if (c.crosses) crossings.emplace_back(e, c.side);
       if (c.touches) visit(B.fan_vertex[s]);
     }
@@ -167,8 +175,9 @@ void append(SumFacets& out, const std::vector<FacetBuffer>& buffers) {
 }  // namespace
 
 SumFacets fims_facets(const Polytope& A, const Polytope& B) {
-  const std::vector<Location> loc_a = locate_all(A, B);  // contributing vertices of A's facets
-  const std::vector<Location> loc_b = locate_all(B, A);  // where B's facets sit on A
+  const std::vector<ArcPlane> planes_a = arc_planes(A), planes_b = arc_planes(B);
+  const std::vector<Location> loc_a = locate_all(A, B, planes_b);  // contributing vertices of A's facets
+  const std::vector<Location> loc_b = locate_all(B, A, planes_a);  // where B's facets sit on A
 
   // Translated facets: one per facet of A.
   const auto translated = in_chunks(A.num_faces(), [&](int begin, int end, FacetBuffer& out) {
@@ -190,7 +199,7 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
       if (l.kind == Location::Kind::vertex && r.kind == Location::Kind::vertex &&
           l.index == r.index)
         continue;
-      edge_facets(A, a, B, l, w, out);
+      edge_facets(A, a, planes_a[a], B, planes_b, l, w, out);
     }
   });
 
