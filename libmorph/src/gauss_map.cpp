@@ -15,19 +15,41 @@ bool between(const NormalRef& p, const NormalRef& x, const NormalRef& q) {
   return cross_dot_normals(p, x, p, q) >= 0 && cross_dot_normals(x, q, p, q) >= 0;
 }
 
-/// Signs of det(N_fan[i], N_fan[i+1], p) for the slots of v's region, walking on at the
-/// first negative one. Returns the slot to cross, or -1 when p is in the closed region,
-/// with `zeros` holding the slots whose arc contains p.
+/// Signs of det(N_fan[i], N_fan[i+1], p) for the slots of v's region. Returns a slot
+/// whose sign is negative (the one the double filter finds most negative, when it finds
+/// one: the walk heads toward p), or -1 when p is in the closed region, with `zeros` then
+/// holding the slots whose arc contains p.
 int region_test(const Polytope& P, const std::vector<ArcPlane>& planes, int v, const NormalRef& p,
                 int zeros[2], int& nzeros) {
   const int b = P.fan_begin[v], n = P.fan_begin[v + 1] - b;
   nzeros = 0;
+  // Slot i's arc joins fan_face[i] and fan_face[i + 1]: its edge's left and right facets
+  // in either order.
+  auto flipped = [&](int i, int e) { return P.edges[e].left != P.fan_face[b + i]; };
+  // The double stage of orient_arc on every slot at once.
+  const UnitNormal& u = p.unit();
+  bool inside = true;
+  int most = -1;
+  double lowest = 0;
   for (int i = 0; i < n; ++i) {
-    // Slot i's arc joins fan_face[i] and fan_face[i + 1]: its edge's left and right facets
-    // in either order.
+    const int e = P.fan_edge[b + i];
+    const ArcPlane& c = planes[e];
+    double d = u.x * c.x + u.y * c.y + u.z * c.z;
+    if (flipped(i, e)) d = -d;
+    const double bound = c.error + u.error + kUnitPredicateRounding;
+    if (!(d > bound)) inside = false;
+    if (d < -bound && d < lowest) {
+      lowest = d;
+      most = i;
+    }
+  }
+  if (inside) return -1;
+  if (most >= 0) return most;
+  // Undecided slots, none certainly negative: decide each.
+  for (int i = 0; i < n; ++i) {
     const int e = P.fan_edge[b + i];
     const int t = orient_arc(P, e, planes[e], p);
-    const int s = P.edges[e].left == P.fan_face[b + i] ? t : -t;
+    const int s = flipped(i, e) ? -t : t;
     if (s < 0) return i;
     if (s == 0) {
       if (nzeros == 2) throw error("internal error: a direction lies on three arcs of one region");
