@@ -60,16 +60,29 @@ std::vector<FacetBuffer> in_chunks(int n, const Body& body) {
 /// x_is_a), located at `loc` in Y's Gauss map.
 void facet_at_normal(const Polytope& X, int f, const Polytope& Y, const Location& loc, bool x_is_a,
                      FacetBuffer& out) {
+  const Element ex{Element::Kind::facet, X.face_source[f]};
+  const Element ey = element_of(Y, loc);
+  const FacetOrigin origin = x_is_a ? FacetOrigin{FacetKind::translated, ex, ey}
+                                    : FacetOrigin{FacetKind::corner, ey, ex};
+  if (loc.kind == Location::Kind::vertex) {
+    // Inside a region of Y (the usual case) the overlay is f's own arcs: f moved by the
+    // vertex, its corners in the order overlay_regions gives them (from corner 1 on).
+    const int d = X.degree(f), b = X.face_begin[f], y = loc.index;
+    for (int k = 1; k <= d; ++k) {
+      const int x = X.corner_vertex[b + (k == d ? 0 : k)];
+      out.corners.push_back(x_is_a ? pair_key(x, y) : pair_key(y, x));
+    }
+    out.sizes.push_back(d);
+    out.origins.push_back(origin);
+    return;
+  }
   arcs_around(X, {Location::Kind::face, f}, out.x_arcs);
   arcs_around(Y, loc, out.y_arcs);
   out.pairs.clear();
   overlay_regions(NormalRef{&X, f}, out.x_arcs, out.y_arcs, loc.index, out.pairs);
   if (!x_is_a)
     for (auto& c : out.pairs) std::swap(c.first, c.second);
-  const Element ex{Element::Kind::facet, X.face_source[f]};
-  const Element ey = element_of(Y, loc);
-  out.add(x_is_a ? FacetOrigin{FacetKind::translated, ex, ey}
-                 : FacetOrigin{FacetKind::corner, ey, ex});
+  out.add(origin);
 }
 
 /// Per-thread marks for the walks of edge_facets, over B's elements.
