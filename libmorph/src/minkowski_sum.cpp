@@ -100,11 +100,13 @@ struct WalkScratch {
 /// Appends the edge facets of edge a of A: for each edge of B whose arc the arc of a
 /// crosses (in B's edge order), the parallelogram a (+) b counter-clockwise about its
 /// outward normal. The crossings are found by a breadth-first walk over the regions of B
-/// that the arc touches, starting where the arc starts; each of B's normals is tested
-/// against the arc's great circle once.
+/// that the arc touches, starting where the arc starts (`start`); each of B's normals is
+/// tested against the arc's great circle once. The region where the arc ends, when its end
+/// is inside one (`end`), is not walked on from: the arc enters it once and stays (a convex
+/// region), so its one crossing into it is found from the region before.
 void edge_facets(const Polytope& A, int a, const ArcPlane& plane_a, const Polytope& B,
-                 const std::vector<ArcPlane>& planes_b, const Location& start, WalkScratch& w,
-                 FacetBuffer& out) {
+                 const std::vector<ArcPlane>& planes_b, const Location& start,
+                 const Location& end, WalkScratch& w, FacetBuffer& out) {
   const auto& ea = A.edges[a];
   const NormalRef n1{&A, ea.left}, n2{&A, ea.right};
   const int stamp = a + 1;
@@ -136,8 +138,10 @@ void edge_facets(const Polytope& A, int a, const ArcPlane& plane_a, const Polyto
   }
   std::vector<std::pair<int, int>>& crossings = out.pairs;  // (edge of B, side)
   crossings.clear();
+  const int last = end.kind == Location::Kind::vertex ? end.index : -1;
   for (std::size_t q = 0; q < w.queue.size(); ++q) {
     const int v = w.queue[q];
+    if (v == last) continue;
     for (int s = B.fan_begin[v]; s < B.fan_begin[v + 1]; ++s) {
       const int e = B.fan_edge[s];
       if (w.edge_stamp[e] == stamp) continue;
@@ -212,7 +216,7 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
       if (l.kind == Location::Kind::vertex && r.kind == Location::Kind::vertex &&
           l.index == r.index)
         continue;
-      edge_facets(A, a, planes_a[a], B, planes_b, l, w, out);
+      edge_facets(A, a, planes_a[a], B, planes_b, l, r, w, out);
     }
   });
 
