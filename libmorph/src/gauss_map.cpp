@@ -153,8 +153,8 @@ std::vector<Location> locate_all(const Polytope& from, const Polytope& in,
   return loc;
 }
 
-ArcContact arc_contact(const NormalRef& n1, const NormalRef& n2, const NormalRef& m1,
-                       const NormalRef& m2, int s1, int s2, int t1, int t2) {
+ArcContact arc_contact_general(const NormalRef& n1, const NormalRef& n2, const NormalRef& m1,
+                               const NormalRef& m2, int s1, int s2, int t1, int t2) {
   ArcContact c;
   if (s1 == 0 && s2 == 0) {  // on one great circle: touching iff they overlap
     c.touches = between(n1, m1, n2) || between(n1, m2, n2) || between(m1, n1, m2);

@@ -70,8 +70,26 @@ struct ArcContact {
 /// arcs against one computes once per normal; t1 and t2 are orient(m1, m2, n1) and
 /// orient(m1, m2, n2), needed only when s1 * s2 <= 0 and not s1 == s2 == 0 (otherwise
 /// the arcs' contact follows from s1 and s2 alone, and a caller may pass anything).
-ArcContact arc_contact(const NormalRef& n1, const NormalRef& n2, const NormalRef& m1,
-                       const NormalRef& m2, int s1, int s2, int t1, int t2);
+/// arc_contact decides the usual cases inline and the rest (the arcs may touch at an end,
+/// or lie on one great circle) with arc_contact_general, which decides them all.
+ArcContact arc_contact_general(const NormalRef& n1, const NormalRef& n2, const NormalRef& m1,
+                               const NormalRef& m2, int s1, int s2, int t1, int t2);
+inline ArcContact arc_contact(const NormalRef& n1, const NormalRef& n2, const NormalRef& m1,
+                              const NormalRef& m2, int s1, int s2, int t1, int t2) {
+  // The usual cases inline: m strictly on one side of n's great circle (no contact), or
+  // each arc's ends strictly on both sides of the other's circle.
+  ArcContact c;
+  if (s1 * s2 > 0) return c;
+  if (s1 * s2 < 0 && t1 * t2 != 0) {
+    // The great circles meet at +-X; the arcs share X (not -X) iff t1 == -s1.
+    if (t1 * t2 < 0) {
+      c.touches = c.crosses = t1 == -s1;
+      c.side = s2;
+    }
+    return c;
+  }
+  return arc_contact_general(n1, n2, m1, m2, s1, s2, t1, t2);
+}
 
 /// Whether arc_contact needs t1 and t2 for these s1 and s2.
 inline bool arc_contact_needs_t(int s1, int s2) { return s1 * s2 <= 0 && (s1 != 0 || s2 != 0); }

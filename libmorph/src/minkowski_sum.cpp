@@ -62,8 +62,8 @@ void facet_at_normal(const Polytope& X, int f, const Polytope& Y, const Location
                      FacetBuffer& out) {
   const Element ex{Element::Kind::facet, X.face_source[f]};
   const Element ey = element_of(Y, loc);
-  const FacetOrigin origin = x_is_a ? FacetOrigin{FacetKind::translated, ex, ey}
-                                    : FacetOrigin{FacetKind::corner, ey, ex};
+  const FacetOrigin origin =
+      x_is_a ? FacetOrigin{FacetKind::translated, ex, ey} : FacetOrigin{FacetKind::corner, ey, ex};
   if (loc.kind == Location::Kind::vertex) {
     // Inside a region of Y (the usual case) the overlay is f's own arcs: f moved by the
     // vertex, its corners in the order overlay_regions gives them (from corner 1 on).
@@ -105,8 +105,8 @@ struct WalkScratch {
 /// is inside one (`end`), is not walked on from: the arc enters it once and stays (a convex
 /// region), so its one crossing into it is found from the region before.
 void edge_facets(const Polytope& A, int a, const ArcPlane& plane_a, const Polytope& B,
-                 const std::vector<ArcPlane>& planes_b, const Location& start,
-                 const Location& end, WalkScratch& w, FacetBuffer& out) {
+                 const std::vector<ArcPlane>& planes_b, const Location& start, const Location& end,
+                 WalkScratch& w, FacetBuffer& out) {
   const auto& ea = A.edges[a];
   const NormalRef n1{&A, ea.left}, n2{&A, ea.right};
   const int stamp = a + 1;
@@ -193,8 +193,9 @@ void append(SumFacets& out, const std::vector<FacetBuffer>& buffers) {
 
 SumFacets fims_facets(const Polytope& A, const Polytope& B) {
   const std::vector<ArcPlane> planes_a = arc_planes(A), planes_b = arc_planes(B);
-  const std::vector<Location> loc_a = locate_all(A, B, planes_b);  // contributing vertices of A's facets
-  const std::vector<Location> loc_b = locate_all(B, A, planes_a);  // where B's facets sit on A
+  // The contributing vertices of A's facets; where B's facets sit on A.
+  const std::vector<Location> loc_a = locate_all(A, B, planes_b);
+  const std::vector<Location> loc_b = locate_all(B, A, planes_a);
 
   // Translated facets: one per facet of A.
   const auto translated = in_chunks(A.num_faces(), [&](int begin, int end, FacetBuffer& out) {
