@@ -141,11 +141,13 @@ std::vector<Location> locate_all(const Polytope& from, const Polytope& in) {
 }
 
 std::vector<Location> locate_all(const Polytope& from, const Polytope& in,
-                                 const std::vector<ArcPlane>& in_planes) {
+                                 const std::vector<ArcPlane>& in_planes,
+                                 const std::vector<int>* hints) {
   std::vector<Location> loc(from.num_faces());
   parallel_chunks(from.num_faces(), 256, [&](int begin, int end) {
     int hint = 0;
     for (int f = begin; f < end; ++f) {
+      if (hints && (*hints)[f] >= 0) hint = (*hints)[f];
       loc[f] = locate(in, in_planes, NormalRef{&from, f}, hint);
       hint = location_vertex(in, loc[f]);
     }

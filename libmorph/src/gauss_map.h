@@ -56,9 +56,11 @@ int location_vertex(const Polytope& P, const Location& loc);
 /// starting from the previous facet's answer (facets near in index order are usually
 /// near on the sphere).
 std::vector<Location> locate_all(const Polytope& from, const Polytope& in);
-/// The same with in's arc planes already made.
+/// The same with in's arc planes already made, and optionally a vertex of `in` per facet of
+/// `from` where its walk starts (-1: where the previous facet's ended).
 std::vector<Location> locate_all(const Polytope& from, const Polytope& in,
-                                 const std::vector<ArcPlane>& in_planes);
+                                 const std::vector<ArcPlane>& in_planes,
+                                 const std::vector<int>* hints = nullptr);
 
 /// How the arc (n1, n2) meets the arc (m1, m2) (both shorter than a half circle).
 struct ArcContact {

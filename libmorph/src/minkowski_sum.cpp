@@ -176,6 +176,27 @@ void edge_facets(const Polytope& A, int a, const ArcPlane& plane_a, const Polyto
   }
 }
 
+/// Where to start locating each facet g of B in A's Gauss map, from A's facets located
+/// in B's: N_g lies on the region of each of its corners c, so near the normal of any
+/// facet f of A whose contributing vertex is c, and a corner of f has its region near N_f.
+/// -1 where no corner of g contributes.
+std::vector<int> walk_starts(const Polytope& A, const Polytope& B,
+                             const std::vector<Location>& loc_a) {
+  std::vector<int> facet_at(B.num_vertices(), -1);  // a facet of A contributed to by the vertex
+  for (int f = 0; f < A.num_faces(); ++f)
+    if (loc_a[f].kind == Location::Kind::vertex) facet_at[loc_a[f].index] = f;
+  std::vector<int> starts(B.num_faces(), -1);
+  parallel_chunks(B.num_faces(), 4096, [&](int begin, int end) {
+    for (int g = begin; g < end; ++g)
+      for (int k = 0; k < B.degree(g); ++k)
+        if (const int f = facet_at[B.corner(g, k)]; f >= 0) {
+          starts[g] = A.corner(f, 0);
+          break;
+        }
+  });
+  return starts;
+}
+
 void append(SumFacets& out, const std::vector<FacetBuffer>& buffers) {
   std::size_t faces = out.origins.size(), corners = out.corners.size();
   for (const auto& b : buffers) faces += b.origins.size(), corners += b.corners.size();
@@ -195,7 +216,8 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
   const std::vector<ArcPlane> planes_a = arc_planes(A), planes_b = arc_planes(B);
   // The contributing vertices of A's facets; where B's facets sit on A.
   const std::vector<Location> loc_a = locate_all(A, B, planes_b);
-  const std::vector<Location> loc_b = locate_all(B, A, planes_a);
+  const std::vector<int> hints_b = walk_starts(A, B, loc_a);
+  const std::vector<Location> loc_b = locate_all(B, A, planes_a, &hints_b);
 
   // Translated facets: one per facet of A.
   const auto translated = in_chunks(A.num_faces(), [&](int begin, int end, FacetBuffer& out) {
