@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <numeric>
 
 #include "fims.h"
@@ -197,17 +198,23 @@ std::vector<int> walk_starts(const Polytope& A, const Polytope& B,
   return starts;
 }
 
-void append(SumFacets& out, const std::vector<FacetBuffer>& buffers) {
-  std::size_t faces = out.origins.size(), corners = out.corners.size();
-  for (const auto& b : buffers) faces += b.origins.size(), corners += b.corners.size();
-  out.face_begin.reserve(faces + 1);
-  out.origins.reserve(faces);
+/// The facets of the buffers, in order: sizes summed once, each array filled in one go.
+SumFacets gather(std::initializer_list<const std::vector<FacetBuffer>*> lists) {
+  std::size_t faces = 0, corners = 0;
+  for (const auto* list : lists)
+    for (const auto& b : *list) faces += b.origins.size(), corners += b.corners.size();
+  SumFacets out;
+  out.face_begin.resize(faces + 1);
   out.corners.reserve(corners);
-  for (const auto& b : buffers) {
-    for (int size : b.sizes) out.face_begin.push_back(out.face_begin.back() + size);
-    out.corners.insert(out.corners.end(), b.corners.begin(), b.corners.end());
-    out.origins.insert(out.origins.end(), b.origins.begin(), b.origins.end());
-  }
+  out.origins.reserve(faces);
+  int* begin = out.face_begin.data();
+  for (const auto* list : lists)
+    for (const auto& b : *list) {
+      for (int size : b.sizes) begin[1] = begin[0] + size, ++begin;
+      out.corners.insert(out.corners.end(), b.corners.begin(), b.corners.end());
+      out.origins.insert(out.origins.end(), b.origins.begin(), b.origins.end());
+    }
+  return out;
 }
 
 }  // namespace
@@ -243,11 +250,7 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
     }
   });
 
-  SumFacets out;
-  append(out, translated);
-  append(out, corner);
-  append(out, edge);
-  return out;
+  return gather({&translated, &corner, &edge});
 }
 
 namespace {
