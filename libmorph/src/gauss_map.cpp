@@ -204,7 +204,7 @@ void arcs_around(const Polytope& P, const Location& where, std::vector<Arc>& out
 
 void overlay_regions(const NormalRef& p, const std::vector<Arc>& x_arcs,
                      const std::vector<Arc>& y_arcs, int y_region,
-                     std::vector<std::pair<int, int>>& out) {
+                     std::vector<std::pair<int, int>>& out, std::vector<int>& halves) {
   const int nx = static_cast<int>(x_arcs.size()), ny = static_cast<int>(y_arcs.size());
   if (ny == 0) {
     for (int i = 0; i < nx; ++i) out.emplace_back(x_arcs[i].after, y_region);
@@ -224,9 +224,9 @@ void overlay_regions(const NormalRef& p, const std::vector<Arc>& x_arcs,
     if (h1 == 0 || h1 == 2) return 0;
     return -orient(p, q1, q2);  // q1 before q2 when q2 is counter-clockwise of q1
   };
-  thread_local std::vector<int> hx, hy;  // reused: this runs once per facet of the result
-  hx.resize(nx);
-  hy.resize(ny);
+  halves.resize(nx + ny);  // the x arcs' halves, then the y arcs'
+  int* const hx = halves.data();
+  int* const hy = hx + nx;
   for (int i = 0; i < nx; ++i) hx[i] = i == 0 ? 0 : half(x_arcs[i].to);
   for (int j = 0; j < ny; ++j) hy[j] = half(y_arcs[j].to);
   // The y arcs are cyclically sorted: start at the smallest angle.

@@ -110,9 +110,9 @@ void arcs_around(const Polytope& P, const Location& where, std::vector<Arc>& out
 /// The regions around the point `p` after overlaying two maps: x_arcs (non-empty,
 /// counter-clockwise) and y_arcs (counter-clockwise, possibly empty, in which case the
 /// point lies inside the region y_region). Appends (x vertex, y vertex) pairs,
-/// counter-clockwise, one per distinct arc direction.
+/// counter-clockwise, one per distinct arc direction. `halves` is scratch.
 void overlay_regions(const NormalRef& p, const std::vector<Arc>& x_arcs,
                      const std::vector<Arc>& y_arcs, int y_region,
-                     std::vector<std::pair<int, int>>& out);
+                     std::vector<std::pair<int, int>>& out, std::vector<int>& halves);
 
 }  // namespace morph::detail

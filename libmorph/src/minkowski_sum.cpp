@@ -37,6 +37,7 @@ struct FacetBuffer {
   std::vector<FacetOrigin> origins;
   std::vector<std::pair<int, int>> pairs;  // scratch
   std::vector<Arc> x_arcs, y_arcs;         // scratch
+  std::vector<int> halves;                 // scratch
 
   void add(const FacetOrigin& origin) {
     for (const auto& [i, j] : pairs) corners.push_back(pair_key(i, j));
@@ -52,7 +53,13 @@ std::vector<FacetBuffer> in_chunks(int n, const Body& body) {
   const int chunks = (n + kGrain - 1) / kGrain;
   std::vector<FacetBuffer> buffers(chunks);
   parallel_chunks(chunks, 1, [&](int first, int last) {
-    for (int c = first; c < last; ++c) body(c * kGrain, std::min(n, (c + 1) * kGrain), buffers[c]);
+    for (int c = first; c < last; ++c) {
+      // About one facet per element, of about four corners.
+      buffers[c].sizes.reserve(kGrain);
+      buffers[c].origins.reserve(kGrain);
+      buffers[c].corners.reserve(4 * kGrain);
+      body(c * kGrain, std::min(n, (c + 1) * kGrain), buffers[c]);
+    }
   });
   return buffers;
 }
@@ -80,7 +87,7 @@ void facet_at_normal(const Polytope& X, int f, const Polytope& Y, const Location
   arcs_around(X, {Location::Kind::face, f}, out.x_arcs);
   arcs_around(Y, loc, out.y_arcs);
   out.pairs.clear();
-  overlay_regions(NormalRef{&X, f}, out.x_arcs, out.y_arcs, loc.index, out.pairs);
+  overlay_regions(NormalRef{&X, f}, out.x_arcs, out.y_arcs, loc.index, out.pairs, out.halves);
   if (!x_is_a)
     for (auto& c : out.pairs) std::swap(c.first, c.second);
   out.add(origin);
