@@ -31,12 +31,19 @@ struct ArcPlane {
 std::vector<ArcPlane> arc_planes(const Polytope& P);
 
 /// Sign of det(N_left, N_right, x) for edge e of P, whose arc's plane is `plane`.
-inline int orient_arc(const Polytope& P, int e, const ArcPlane& plane, const NormalRef& x) {
+/// Its double stage alone: the sign, or kUndecided.
+inline constexpr int kUndecided = 2;
+inline int orient_arc_filter(const ArcPlane& plane, const NormalRef& x) {
   const UnitNormal& u = x.unit();
   const double d = u.x * plane.x + u.y * plane.y + u.z * plane.z;
   const double bound = plane.error + u.error + kUnitPredicateRounding;
   if (d > bound) return 1;
   if (d < -bound) return -1;
+  return kUndecided;
+}
+inline int orient_arc(const Polytope& P, int e, const ArcPlane& plane, const NormalRef& x) {
+  const int s = orient_arc_filter(plane, x);
+  if (s != kUndecided) return s;
   return orient_normals_undecided(NormalRef{&P, P.edges[e].left}, NormalRef{&P, P.edges[e].right},
                                   x);
 }

@@ -96,7 +96,8 @@ void facet_at_normal(const Polytope& X, int f, const Polytope& Y, const Location
 /// Per-thread marks for the walks of edge_facets, over B's elements.
 struct WalkScratch {
   std::vector<int> region_stamp, edge_stamp, face_stamp;
-  std::vector<signed char> face_side;  // orient(n1, n2, N_g), valid when face_stamp[g] is current
+  std::vector<signed char>
+      face_side;  // orient(n1, n2, N_g) or kUndecided, when face_stamp[g] is current
   std::vector<int> queue;
   explicit WalkScratch(const Polytope& B)
       : region_stamp(B.num_vertices(), 0),
@@ -125,11 +126,18 @@ void edge_facets(const Polytope& A, int a, const ArcPlane& plane_a, const Polyto
       w.queue.push_back(v);
     }
   };
+  // orient(n1, n2, N_g): first by the double stage alone (kUndecided when it cannot tell),
+  // exactly only when needed.
   auto side = [&](int g) {
     if (w.face_stamp[g] != stamp) {
       w.face_stamp[g] = stamp;
-      w.face_side[g] = static_cast<signed char>(orient_arc(A, a, plane_a, NormalRef{&B, g}));
+      w.face_side[g] = static_cast<signed char>(orient_arc_filter(plane_a, NormalRef{&B, g}));
     }
+    return static_cast<int>(w.face_side[g]);
+  };
+  auto exact_side = [&](int g) {
+    if (w.face_side[g] == kUndecided)
+      w.face_side[g] = static_cast<signed char>(orient_arc(A, a, plane_a, NormalRef{&B, g}));
     return static_cast<int>(w.face_side[g]);
   };
   switch (start.kind) {
@@ -155,7 +163,15 @@ void edge_facets(const Polytope& A, int a, const ArcPlane& plane_a, const Polyto
       if (w.edge_stamp[e] == stamp) continue;
       w.edge_stamp[e] = stamp;
       const auto& eb = B.edges[e];
-      const int s1 = side(eb.left), s2 = side(eb.right);
+      int s1 = side(eb.left), s2 = side(eb.right);
+      if (s1 == kUndecided || s2 == kUndecided) {
+        // Nearly on a's great circle. Before deciding exactly: a's arc strictly on one side
+        // of b's great circle touches nothing.
+        const int u1 = orient_arc_filter(planes_b[e], n1), u2 = orient_arc_filter(planes_b[e], n2);
+        if (u1 != kUndecided && u2 != kUndecided && u1 * u2 > 0) continue;
+        s1 = exact_side(eb.left);
+        s2 = exact_side(eb.right);
+      }
       if (s1 * s2 > 0) continue;  // b's arc strictly on one side of a's great circle
       int t1 = 0, t2 = 0;
       if (arc_contact_needs_t(s1, s2)) {
