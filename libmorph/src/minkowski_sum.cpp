@@ -96,8 +96,8 @@ void facet_at_normal(const Polytope& X, int f, const Polytope& Y, const Location
 /// Per-thread marks for the walks of edge_facets, over B's elements.
 struct WalkScratch {
   std::vector<int> region_stamp, edge_stamp, face_stamp;
-  std::vector<signed char>
-      face_side;  // orient(n1, n2, N_g) or kUndecided, when face_stamp[g] is current
+  // orient(n1, n2, N_g), or kUndecided, when face_stamp[g] is current.
+  std::vector<signed char> face_side;
   std::vector<int> queue;
   explicit WalkScratch(const Polytope& B)
       : region_stamp(B.num_vertices(), 0),
