@@ -85,26 +85,22 @@ std::vector<ArcPlane> arc_planes(const Polytope& P) {
 
 Location locate(const Polytope& P, const std::vector<ArcPlane>& planes, const NormalRef& p,
                 int hint) {
-  // First a cheap climb in doubles: to the neighbour with the largest support value
-  // <p, x>, while it strictly grows (so it ends). It only picks where the exact walk
-  // starts, which then usually finds the region at once.
+  // First one cheap step in doubles: to the neighbour of the hint with the largest support
+  // value <p, x>, if it beats the hint's. It only picks where the exact walk starts, which
+  // then usually finds the region at once (climbing on to the top in doubles costs a scan
+  // of the top's neighbours, more than the region test it would spare).
   int v = hint;
   {
     const UnitNormal& d = p.unit();
     auto support = [&](int w) {
       return d.x * P.points[w].x + d.y * P.points[w].y + d.z * P.points[w].z;
     };
-    double best = support(v);
-    for (bool moved = true; moved;) {
-      moved = false;
-      const int from = v;
-      for (int s = P.fan_begin[from]; s < P.fan_begin[from + 1]; ++s) {
-        const double h = support(P.fan_vertex[s]);
-        if (h > best) {
-          best = h;
-          v = P.fan_vertex[s];
-          moved = true;
-        }
+    double best = support(hint);
+    for (int s = P.fan_begin[hint]; s < P.fan_begin[hint + 1]; ++s) {
+      const double h = support(P.fan_vertex[s]);
+      if (h > best) {
+        best = h;
+        v = P.fan_vertex[s];
       }
     }
   }

@@ -50,9 +50,10 @@ inline int orient_arc(const Polytope& P, int e, const ArcPlane& plane, const Nor
 
 /// Locates the direction `p` in P's Gauss map (`planes`: its arc_planes): the vertex whose region
 /// contains it in its interior (the contributing vertex), the edge whose arc contains it, or the
-/// facet whose normal has its direction. The walk starts at vertex `hint`, climbs the support
-/// function in doubles (only to choose where to start), then walks exactly from region to
-/// region; the answer is exact and does not depend on the hint. Expected O(distance walked).
+/// facet whose normal has its direction. The walk starts at vertex `hint`, takes one step up
+/// the support function in doubles (only to choose where to start), then walks exactly from
+/// region to region; the answer is exact and does not depend on the hint. Expected
+/// O(distance walked).
 Location locate(const Polytope& P, const std::vector<ArcPlane>& planes, const NormalRef& p,
                 int hint);
 
