@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "../libmorph/src/gauss_map.h"
 #include "../libmorph/src/halfspace_intersection.h"
 #include "../libmorph/src/polytope.h"
 #include "support/polytopes.h"
@@ -139,4 +140,42 @@ TEST_CASE("normal predicates: the double-double stage on an erosion's given norm
   MESSAGE("erosion: " << tally.triples << " triples, " << tally.zero << " exactly coplanar, "
                       << tally.tiny << " nonzero below the double filter");
   CHECK(tally.triples > 0);
+}
+
+// The kernel orients normals against an arc by its plane N_left x N_right, made once per
+// edge (gauss_map.h): the same double stage evaluated in other operations, with the same
+// bound; it must agree with exact evaluation where the filter is tested hardest.
+TEST_CASE("normal predicates: orientation against an arc's plane agrees with exact evaluation") {
+  const Mesh ico1280 = sample("icosphere_1280.off");
+  const std::vector<std::pair<Mesh, Mesh>> pairs = {
+      {sample("icosphere_320.off"), ico1280},
+      {ico1280, morph::test::transformed(ico1280, small_rotation(1e-12))}};
+  for (const auto& [a, b] : pairs) {
+    const Polytope A = morph::detail::make_operand(a, "A");
+    const Polytope B = morph::detail::make_operand(b, "B");
+    const auto planes = morph::detail::arc_planes(B);
+    int tested = 0, zero = 0;
+    std::vector<int> order(A.num_faces());
+    for (int e = 0; e < B.num_edges(); ++e) {
+      const NormalRef l{&B, B.edges[e].left}, r{&B, B.edges[e].right};
+      // A's facets with the normals closest to the arc's ends.
+      for (const NormalRef& end : {l, r}) {
+        const auto& n = end.unit();
+        std::iota(order.begin(), order.end(), 0);
+        std::partial_sort(order.begin(), order.begin() + 3, order.end(), [&](int f, int g) {
+          const auto &u = A.unit_normals[f], &w = A.unit_normals[g];
+          return n.x * u.x + n.y * u.y + n.z * u.z > n.x * w.x + n.y * w.y + n.z * w.z;
+        });
+        for (int k = 0; k < 3; ++k) {
+          const NormalRef x{&A, order[k]};
+          const int exact = CGAL::sign(morph::detail::det(l.exact(), r.exact(), x.exact()));
+          CHECK(morph::detail::orient_arc(B, e, planes[e], x) == exact);
+          ++tested;
+          zero += exact == 0;
+        }
+      }
+    }
+    CHECK(tested > 0);
+    MESSAGE(tested << " orientations against arcs, " << zero << " exactly zero");
+  }
 }
