@@ -49,13 +49,9 @@ std::string difference(const Polytope& a, const Polytope& b) {
   if (a.vertex_source != b.vertex_source) return "vertex_source";
   if (a.face_source != b.face_source) return "face_source";
   if (a.edge_source != b.edge_source) return "edge_source";
-  const auto same_interval = [](const auto& x, const auto& y) {
-    return x.inf() == y.inf() && x.sup() == y.sup();
-  };
   for (int f = 0; f < a.num_faces(); ++f) {
-    const auto &n = a.normals[f], &m = b.normals[f];
-    if (!same_interval(n.x, m.x) || !same_interval(n.y, m.y) || !same_interval(n.z, m.z))
-      return "normals";
+    const auto &n = a.unit_normals[f], &m = b.unit_normals[f];
+    if (n.x != m.x || n.y != m.y || n.z != m.z || n.error != m.error) return "normals";
   }
   return "";
 }
