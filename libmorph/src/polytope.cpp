@@ -206,20 +206,22 @@ constexpr double kUlp = 0x1p-52;  // one ulp relative to the result: any roundin
 
 /// The unit vector of m (non-zero, finite) with a bound on its distance to the direction
 /// of any vector within `radius` of m: 2 radius / |m| (the normalisation adds a few ulps;
-/// margins cover the rounding of |m| and of the bound). Both are first scaled by a power of
-/// two (exactly) so that |m|^2 neither overflows nor underflows. Infinite error when m
+/// margins cover the rounding of |m| and of the bound). Far from 1, both are first scaled by
+/// a power of two (exactly) so that |m|^2 neither overflows nor underflows. Infinite error when m
 /// does not tell a direction.
 UnitNormal normalised(V3<double> m, double radius) {
   const double largest = std::max({std::abs(m.x), std::abs(m.y), std::abs(m.z)});
   if (!(largest > 0) || !std::isfinite(largest) || !std::isfinite(radius))
     return {0, 0, 0, std::numeric_limits<double>::infinity()};
-  const double scale = std::ldexp(1.0, -std::ilogb(largest));
-  m = {m.x * scale, m.y * scale, m.z * scale};
-  radius *= scale;
-  const double length = std::sqrt(dot(m, m));
-  double error = 2 * radius / length * (1 + 1e-10) + 4e-15;
+  if (!(largest > 1e-100 && largest < 1e100)) {
+    const double scale = std::ldexp(1.0, -std::ilogb(largest));
+    m = {m.x * scale, m.y * scale, m.z * scale};
+    radius *= scale;
+  }
+  const double inverse = 1 / std::sqrt(dot(m, m));
+  double error = 2 * radius * inverse * (1 + 1e-10) + 4e-15;
   if (!std::isfinite(error) || error > 1) error = std::numeric_limits<double>::infinity();
-  return {m.x / length, m.y / length, m.z / length, error};
+  return {m.x * inverse, m.y * inverse, m.z * inverse, error};
 }
 
 /// Facet f's Newell normal computed in doubles from its double points, as a sum of cross
@@ -497,10 +499,11 @@ int unit_edge_convexity(const Polytope& p, const Polytope::Edge& e) {
 
 /// Sign of det(N_left, N_right, to - from): positive when the edge is strictly convex.
 int edge_convexity(const Polytope& p, const Polytope::Edge& e) {
+  // The unit normals decide all but nearly flat edges, reading less than the triangles.
+  if (const int s = unit_edge_convexity(p, e); s != 2) return s;
   if (p.exact_points.empty() && p.degree(e.left) == 3 && p.degree(e.right) == 3) {
     if (const int s = triangle_edge_convexity(p, e); s != 2) return s;
   }
-  if (const int s = unit_edge_convexity(p, e); s != 2) return s;
   if (p.exact_points.empty())
     return CGAL::sign(det(p.exact_normal(e.left), p.exact_normal(e.right),
                           to_exact_n(p.points[e.to]) - to_exact_n(p.points[e.from])));
@@ -522,10 +525,9 @@ void check_gauss_map(const Polytope& p, const char* name) {
     const int b = p.fan_begin[v], n = p.fan_begin[v + 1] - b;
     if (n < 3)
       fail(name, "vertex " + std::to_string(p.vertex_source[v]) + " has fewer than three facets");
-    for (int i = 0; i < n; ++i) {
-      const int s = orient_normals(NormalRef{&p, p.fan_face[b + i]},
-                                   NormalRef{&p, p.fan_face[b + (i + 1) % n]},
-                                   NormalRef{&p, p.fan_face[b + (i + 2) % n]});
+    for (int i = 0, j = 1, k = 2; i < n; ++i, j = k, k = k + 1 == n ? 0 : k + 1) {
+      const int s = orient_normals(NormalRef{&p, p.fan_face[b + i]}, NormalRef{&p, p.fan_face[b + j]},
+                                   NormalRef{&p, p.fan_face[b + k]});
       if (s <= 0)
         fail(name, "the facets around vertex " + std::to_string(p.vertex_source[v]) +
                        " do not turn convexly (the mesh is not convex)");

@@ -123,8 +123,9 @@ Extent bounding_box(const MeshView& m) {
 // at the target of the face's halfedge), read once for all the geometric checks. A
 // deleted face has an empty cycle.
 struct FaceCycles {
-  std::vector<int> begin;   // size F + 1, over all faces
-  std::vector<int> vertex;  // corner k of face f: vertex[begin[f] + k]
+  std::vector<int> begin;     // size F + 1, over all faces
+  std::vector<int> vertex;    // corner k of face f: vertex[begin[f] + k]
+  std::vector<int> across;    // the face across the edge that ends at corner k (if any)
   int degree(int f) const { return begin[f + 1] - begin[f]; }
   const int* corners(int f) const { return vertex.data() + begin[f]; }
 };
@@ -133,6 +134,7 @@ FaceCycles face_cycles(const MeshView& m) {
   FaceCycles cycles;
   cycles.begin.resize(m.n_faces + 1);
   cycles.vertex.reserve(m.n_halfedges);
+  cycles.across.reserve(m.n_halfedges);
   for (int f = 0; f < m.n_faces; ++f) {
     cycles.begin[f] = static_cast<int>(cycles.vertex.size());
     if (!m.live_face(f)) continue;
@@ -143,6 +145,7 @@ FaceCycles face_cycles(const MeshView& m) {
         throw error("internal error: mesh face " + std::to_string(f) +
                     " is not a closed cycle of halfedges");
       cycles.vertex.push_back(m.to(h));
+      cycles.across.push_back(m.face(h ^ 1));
       h = m.next(h);
     } while (h != first);
   }
@@ -304,16 +307,36 @@ FanVolumes fan_volumes(const MeshView& m, const FaceCycles& cycles, const Point&
 }
 
 // What the geometric checks share, gathered in one pass over the faces by
-// nondegenerate(): the extent, the face cycles and unit planes, the fan volumes about the
-// extent's centre, and the first face that is not planar (reported only after the
-// orientation, as the rule orders them).
+// nondegenerate(): the extent, the face cycles, the fan volumes about the extent's
+// centre, the first face that is not planar and whether any edge may be reflex (both
+// reported only after the orientation, as the rule orders them).
 struct Geometry {
   Extent extent;
   FaceCycles cycles;
-  std::vector<FacePlane> planes;  // by face index
   FanVolumes volumes;
   int non_planar_face = -1;
+  bool reflex = false;  // some vertex lies above the plane of a neighbouring face
 };
+
+// The plane of face f with its unit normal (the face is known to be non-degenerate).
+FacePlane unit_plane(const MeshView& m, const FaceCycles& cycles, int f) {
+  FacePlane plane = newell_plane(m.points, cycles.corners(f), cycles.degree(f));
+  plane.normal *= 1.0 / plane.normal.norm();
+  return plane;
+}
+
+// Whether a vertex of face g across f's edge from -> to (other than the edge's ends, which
+// passed f's planarity check) lies above f's plane by more than the tolerance.
+bool reflex_across(const MeshView& m, const FaceCycles& cycles, const FacePlane& plane, int g,
+                   int from, int to, double tolerance) {
+  const int* corners = cycles.corners(g);
+  for (int k = 0; k < cycles.degree(g); ++k) {
+    const int v = corners[k];
+    if (v == from || v == to) continue;
+    if (!(height(plane, m.points[v]) <= tolerance)) return true;
+  }
+  return false;
+}
 
 // Whether two of the n values key(0), ..., key(n - 1) are equal (quadratic: faces are
 // small; sorting would allocate).
@@ -326,8 +349,10 @@ bool has_equal_pair(int n, const Key& key) {
 }
 
 // Fills `geometry` for the later checks when the mesh passes; planarity is judged with
-// `relative_tolerance` times the bounding-box diagonal.
-Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& geometry) {
+// `relative_tolerance` times the bounding-box diagonal. With `convexity` (only for a closed
+// mesh), also whether any edge may be reflex, with each face's plane while it is at hand.
+Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& geometry,
+                      bool convexity = false) {
   for (int v = 0; v < m.n_vertices; ++v) {
     if (!m.live_vertex(v)) continue;
     const Point& p = m.points[v];
@@ -343,7 +368,6 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
                                       number(kMaxSize) + "]");
   const double tolerance = relative_tolerance * diagonal;
   geometry.cycles = face_cycles(m);
-  geometry.planes.resize(m.n_faces);
   for (int f = 0; f < m.n_faces; ++f) {
     if (!m.live_face(f)) continue;
     const int* ids = geometry.cycles.corners(f);
@@ -359,8 +383,7 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
       return fail(Verdict::invalid,
                   face() + " uses vertex " + std::to_string(*twice) + " more than once");
     }
-    FacePlane& plane = geometry.planes[f];
-    plane = newell_plane(m.points, ids, n);
+    FacePlane plane = newell_plane(m.points, ids, n);
     if (has_equal_pair(n, [&](int i) -> const Point& { return m.points[ids[i]]; }))
       return fail(Verdict::invalid, face() + " has two vertices at the same position");
     const double length = plane.normal.norm();
@@ -370,6 +393,12 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
     geometry.volumes.add_face(m.points, ids, n, geometry.extent.centre);
     for (int k = 0; k < n && geometry.non_planar_face < 0; ++k)
       if (!(std::abs(height(plane, m.points[ids[k]])) <= tolerance)) geometry.non_planar_face = f;
+    if (convexity && !geometry.reflex) {
+      const int* across = geometry.cycles.across.data() + geometry.cycles.begin[f];
+      for (int k = 0; k < n && !geometry.reflex; ++k)
+        geometry.reflex = reflex_across(m, geometry.cycles, plane, across[k],
+                                        ids[k == 0 ? n - 1 : k - 1], ids[k], tolerance);
+    }
   }
   return {};
 }
@@ -387,26 +416,29 @@ Finding outward(const FanVolumes& volumes) {
   return {Verdict::ok, {}, volume};
 }
 
-// Planarity (found by nondegenerate()), then edge convexity.
+// Planarity, then edge convexity (both found by nondegenerate(); here the first offender
+// in the rule's order is named).
 Finding planar_and_convex(const MeshView& m, double relative_tolerance, const Geometry& geometry) {
   const double tolerance = relative_tolerance * geometry.extent.diagonal;
   const FaceCycles& cycles = geometry.cycles;
   if (const int f = geometry.non_planar_face; f >= 0) {
+    const FacePlane plane = unit_plane(m, cycles, f);
     const int* corners = cycles.corners(f);
     int k = 0;
-    while (std::abs(height(geometry.planes[f], m.points[corners[k]])) <= tolerance) ++k;
+    while (std::abs(height(plane, m.points[corners[k]])) <= tolerance) ++k;
     return fail(Verdict::not_convex,
                 "face " + std::to_string(f) + " is not planar: vertex " +
                     std::to_string(corners[k]) + " is " +
-                    number(std::abs(height(geometry.planes[f], m.points[corners[k]]))) +
+                    number(std::abs(height(plane, m.points[corners[k]]))) +
                     " from its plane (tolerance " + number(tolerance) + ")");
   }
+  if (!geometry.reflex) return {};
   for (int e = 0; e < m.n_edges; ++e) {
     if (!m.live_edge(e)) continue;
     for (int side = 0; side < 2; ++side) {
       const int h = 2 * e + side;
       const int f = m.face(h), g = m.face(h ^ 1);
-      const FacePlane& plane = geometry.planes[f];
+      const FacePlane plane = unit_plane(m, cycles, f);
       // The edge's own vertices belong to f and passed the planarity check: their height
       // is at most the tolerance, so only g's other vertices can fail.
       const int from = m.from(h), to = m.to(h);
@@ -433,7 +465,8 @@ Finding convex_polyhedron(const Mesh& mesh, double relative_tolerance) {
   const MeshView m(mesh);
   if (Finding found = closed_manifold(m); found.verdict != Verdict::ok) return found;
   Geometry geometry;
-  if (Finding found = nondegenerate(m, relative_tolerance, geometry); found.verdict != Verdict::ok)
+  if (Finding found = nondegenerate(m, relative_tolerance, geometry, true);
+      found.verdict != Verdict::ok)
     return found;
   if (Finding found = outward(geometry.volumes); found.verdict != Verdict::ok) return found;
   return planar_and_convex(m, relative_tolerance, geometry);
