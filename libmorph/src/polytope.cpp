@@ -209,7 +209,7 @@ constexpr double kUlp = 0x1p-52;  // one ulp relative to the result: any roundin
 /// margins cover the rounding of |m| and of the bound). Far from 1, both are first scaled by
 /// a power of two (exactly) so that |m|^2 neither overflows nor underflows. Infinite error when m
 /// does not tell a direction.
-UnitNormal normalised(V3<double> m, double radius) {
+inline UnitNormal normalised(V3<double> m, double radius) {
   const double largest = std::max({std::abs(m.x), std::abs(m.y), std::abs(m.z)});
   if (!(largest > 0) || !std::isfinite(largest) || !std::isfinite(radius))
     return {0, 0, 0, std::numeric_limits<double>::infinity()};
