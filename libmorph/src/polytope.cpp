@@ -565,26 +565,39 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   const int nh = static_cast<int>(mesh.n_halfedges());
   const bool reversed = order == FaceOrder::reversed;
   // Corner c is halfedge corner_halfedge[c] of its face: leaving the corner's vertex when
-  // as given; when reversed, entering it (the facet runs against the halfedges).
-  std::vector<int> corner_halfedge(nh), corner_face(nh), corner_of(nh, -1);
+  // as given; when reversed, entering it (the facet runs against the halfedges). The
+  // temporaries are written before they are read: left uninitialised.
+  std::unique_ptr<int[]> corner_halfedge(new int[nh]);
+  std::vector<int> corner_of(nh, -1);
+  // What the fan walk reads of corner c, together: its facet, the previous corner of the
+  // facet, and the next corner counter-clockwise around its vertex (filled below).
+  struct FanLink {
+    int face, prev, next;
+  };
+  std::unique_ptr<FanLink[]> link(new FanLink[nh]);
   p.face_begin.resize(nf + 1);
   p.corner_vertex.resize(nh);
   int c = 0;
   for (int f = 0; f < nf; ++f) {
     p.face_begin[f] = c;
     const auto h0 = mesh.halfedge_handle(Mesh::FaceHandle(f));
-    // The face circulator starts at the target of h0.
+    // The face circulator starts at the target of h0. As given, a corner's vertex is the
+    // target of the halfedge before it (read with the link to the next one).
     const auto start = reversed ? mesh.prev_halfedge_handle(h0) : mesh.next_halfedge_handle(h0);
+    int from = mesh.to_vertex_handle(h0).idx();
     auto h = start;
     do {
       if (c == nh) throw error("internal error: a mesh face is not a closed cycle");
-      p.corner_vertex[c] = (reversed ? mesh.to_vertex_handle(h) : mesh.from_vertex_handle(h)).idx();
+      p.corner_vertex[c] = reversed ? mesh.to_vertex_handle(h).idx() : from;
       corner_halfedge[c] = h.idx();
-      corner_face[c] = f;
+      link[c].face = f;
+      link[c].prev = c - 1;
       corner_of[h.idx()] = c;
       ++c;
+      if (!reversed) from = mesh.to_vertex_handle(h).idx();
       h = reversed ? mesh.prev_halfedge_handle(h) : mesh.next_halfedge_handle(h);
     } while (h != start);
+    link[p.face_begin[f]].prev = c - 1;
   }
   p.face_begin[nf] = c;
   if (c != nh) throw error("internal error: a mesh halfedge has no face");
@@ -603,20 +616,16 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
     const int t = twin(c);
     if (t < c) continue;  // numbered at t
     const int e = static_cast<int>(p.edges.size());
-    p.edges.push_back({p.corner_vertex[c], p.corner_vertex[t], corner_face[c], corner_face[t]});
+    p.edges.push_back({p.corner_vertex[c], p.corner_vertex[t], link[c].face, link[t].face});
     mesh_edge.push_back(corner_halfedge[c] >> 1);
     p.corner_edge[c] = e;
     p.corner_edge[t] = e;
   }
 
   // Fans, walked as build_connectivity does: from the last corner at v, the next facet
-  // counter-clockwise is across the incoming edge u -> v, at corner fan_next[c] =
-  // twin(prev_corner(c)); precomputed so that the walk follows one link per step.
-  std::vector<int> fan_next(nc);
-  for (int f = 0; f < nf; ++f) {
-    const int b = p.face_begin[f], end = p.face_begin[f + 1];
-    for (c = b; c < end; ++c) fan_next[c] = twin(c == b ? end - 1 : c - 1);
-  }
+  // counter-clockwise is across the incoming edge u -> v, at corner twin(prev corner);
+  // precomputed so that the walk follows one link per step.
+  for (c = 0; c < nc; ++c) link[c].next = twin(link[c].prev);
   std::vector<int> some_corner(nv, -1);
   for (c = 0; c < nc; ++c) some_corner[p.corner_vertex[c]] = c;
   p.fan_begin.resize(nv + 1);
@@ -631,13 +640,12 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
     c = first;
     do {
       if (slot == nc) throw error("internal error: a mesh vertex has a broken fan");
-      const int f = corner_face[c];
-      const int pc = c == p.face_begin[f] ? p.face_begin[f + 1] - 1 : c - 1;
-      p.fan_face[slot] = f;
-      p.fan_edge[slot] = p.corner_edge[pc];
-      p.fan_vertex[slot] = p.corner_vertex[pc];
+      const FanLink& l = link[c];
+      p.fan_face[slot] = l.face;
+      p.fan_edge[slot] = p.corner_edge[l.prev];
+      p.fan_vertex[slot] = p.corner_vertex[l.prev];
       ++slot;
-      c = fan_next[c];
+      c = l.next;
     } while (c != first);
   }
   p.fan_begin[nv] = slot;
