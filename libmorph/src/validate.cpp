@@ -172,15 +172,19 @@ Finding closed_manifold(const MeshView& m) {
   // A vertex is manifold when the faces around it form one fan: the circulator around
   // it (which walks one fan) must meet every halfedge leaving it, and reach each
   // neighbour once (two edges between the same vertices pinch the surface).
-  std::vector<int> outgoing(m.n_vertices, 0);
-  for (int h = 0; h < m.n_halfedges; ++h)
-    if (m.live_halfedge(h)) ++outgoing[m.from(h)];
   enum class Fan : char { unreached, queued, one, isolated, several, pinched };
-  // seen[w] == v: w was already reached from v (a stamp, so the array is never cleared).
-  std::vector<int> seen(m.n_vertices, -1);
+  // What the walks know of a vertex, kept together (a walk reads them for each neighbour).
+  struct VertexState {
+    int outgoing = 0;  // live halfedges leaving it
+    int seen = -1;     // == v: reached from v already (a stamp, never cleared)
+    Fan fan = Fan::unreached;
+  };
+  std::vector<VertexState> state(m.n_vertices);
+  for (int h = 0; h < m.n_halfedges; ++h)
+    if (m.live_halfedge(h)) ++state[m.from(h)].outgoing;
   // Walks the fan of v, calling visit(w) for each neighbour w it reaches.
   const auto walk_fan = [&](int v, const auto& visit) {
-    if (outgoing[v] == 0) return Fan::isolated;
+    if (state[v].outgoing == 0) return Fan::isolated;
     int reached = 0;
     bool pinched = false;
     // The outgoing halfedges around v, as the circulator walks them.
@@ -189,12 +193,12 @@ Finding closed_manifold(const MeshView& m) {
     do {
       const int w = m.to(h);
       visit(w);
-      pinched = pinched || seen[w] == v;
-      seen[w] = v;
-      if (++reached > outgoing[v]) break;  // corrupt links
+      pinched = pinched || state[w].seen == v;
+      state[w].seen = v;
+      if (++reached > state[v].outgoing) break;  // corrupt links
       h = m.next(h ^ 1);
     } while (h != first);
-    if (reached != outgoing[v]) return Fan::several;
+    if (reached != state[v].outgoing) return Fan::several;
     return pinched ? Fan::pinched : Fan::one;
   };
 
@@ -203,23 +207,22 @@ Finding closed_manifold(const MeshView& m) {
   // pass); then the vertices are judged in index order, as the rule lists them.
   int first = 0;
   while (first < m.n_vertices && !m.live_vertex(first)) ++first;
-  std::vector<Fan> fan(m.n_vertices, Fan::unreached);
   std::vector<int> stack;
   const auto reach = [&](int w) {
-    if (fan[w] != Fan::unreached) return;
-    fan[w] = Fan::queued;
+    if (state[w].fan != Fan::unreached) return;
+    state[w].fan = Fan::queued;
     stack.push_back(w);
   };
   if (first < m.n_vertices) reach(first);
   while (!stack.empty()) {
     const int v = stack.back();
     stack.pop_back();
-    fan[v] = walk_fan(v, reach);
+    state[v].fan = walk_fan(v, reach);
   }
   for (int v = 0; v < m.n_vertices; ++v) {
     if (!m.live_vertex(v)) continue;
     ++n_vertices;
-    const Fan found = fan[v] == Fan::unreached ? walk_fan(v, [](int) {}) : fan[v];
+    const Fan found = state[v].fan == Fan::unreached ? walk_fan(v, [](int) {}) : state[v].fan;
     if (found == Fan::isolated)
       return fail(Verdict::invalid,
                   "vertex " + std::to_string(v) + " is isolated (it belongs to no face)");
@@ -239,7 +242,7 @@ Finding closed_manifold(const MeshView& m) {
     }
   }
   for (int v = first + 1; v < m.n_vertices; ++v)
-    if (m.live_vertex(v) && fan[v] == Fan::unreached)
+    if (m.live_vertex(v) && state[v].fan == Fan::unreached)
       return fail(Verdict::invalid, "the mesh is not connected: vertex " + std::to_string(v) +
                                         " is not connected to vertex " + std::to_string(first));
 
