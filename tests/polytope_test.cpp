@@ -280,7 +280,8 @@ namespace {
 
 // Whether unit normal u lies within u.error of the direction of the exact normal n, decided
 // exactly: |u - n/|n||^2 <= e^2 <=> 2 u.n >= s |n| with s = |u|^2 + 1 - e^2 (u, e doubles).
-bool within_error(const morph::detail::UnitNormal& u, const morph::detail::V3<morph::detail::ExactN>& n) {
+bool within_error(const morph::detail::UnitNormal& u,
+                  const morph::detail::V3<morph::detail::ExactN>& n) {
   using morph::detail::ExactN;
   if (!std::isfinite(u.error)) return true;
   const ExactN x(u.x), y(u.y), z(u.z), e(u.error);

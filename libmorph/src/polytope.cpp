@@ -250,7 +250,8 @@ UnitNormal unit_newell(const std::vector<V3<double>>& points, const int* corners
   }
   const double factor = (d + 2) * kUlp * 1.01, absolute = d * 0x1p-1000;
   // The bound of each component, summed: a bound on the Euclidean distance.
-  return normalised(sum, (factor * (magnitude.x + magnitude.y + magnitude.z) + 3 * absolute) * 1.01);
+  return normalised(sum,
+                    (factor * (magnitude.x + magnitude.y + magnitude.z) + 3 * absolute) * 1.01);
 }
 
 /// The unit normal of an interval enclosure n of a facet's Newell normal: its midpoint m,
@@ -483,14 +484,14 @@ int unit_edge_convexity(const Polytope& p, const Polytope::Edge& e) {
     const V3<Interval> di = p.interval_point(e.to) - p.interval_point(e.from);
     d = {0.5 * (di.x.inf() + di.x.sup()), 0.5 * (di.y.inf() + di.y.sup()),
          0.5 * (di.z.inf() + di.z.sup())};
-    radius = ((di.x.sup() - di.x.inf()) + (di.y.sup() - di.y.inf()) + (di.z.sup() - di.z.inf())) *
-             1.01;
+    radius =
+        ((di.x.sup() - di.x.inf()) + (di.y.sup() - di.y.inf()) + (di.z.sup() - di.z.inf())) * 1.01;
   }
   const double length = std::abs(d.x) + std::abs(d.y) + std::abs(d.z);  // >= |d'|
   // Products must not underflow (the bound is relative), nor |d'| overflow.
   if (!(length > 1e-250 && length < 1e250)) return 2;
-  const double value = d.x * (a.y * b.z - a.z * b.y) + d.y * (a.z * b.x - a.x * b.z) +
-                       d.z * (a.x * b.y - a.y * b.x);
+  const double value =
+      d.x * (a.y * b.z - a.z * b.y) + d.y * (a.z * b.x - a.x * b.z) + d.z * (a.x * b.y - a.y * b.x);
   const double bound = ((a.error + b.error + kUnitPredicateRounding) * length + radius) * 1.01;
   if (value > bound) return 1;
   if (value < -bound) return -1;
@@ -526,8 +527,9 @@ void check_gauss_map(const Polytope& p, const char* name) {
     if (n < 3)
       fail(name, "vertex " + std::to_string(p.vertex_source[v]) + " has fewer than three facets");
     for (int i = 0, j = 1, k = 2; i < n; ++i, j = k, k = k + 1 == n ? 0 : k + 1) {
-      const int s = orient_normals(NormalRef{&p, p.fan_face[b + i]}, NormalRef{&p, p.fan_face[b + j]},
-                                   NormalRef{&p, p.fan_face[b + k]});
+      const int s =
+          orient_normals(NormalRef{&p, p.fan_face[b + i]}, NormalRef{&p, p.fan_face[b + j]},
+                         NormalRef{&p, p.fan_face[b + k]});
       if (s <= 0)
         fail(name, "the facets around vertex " + std::to_string(p.vertex_source[v]) +
                        " do not turn convexly (the mesh is not convex)");

@@ -123,9 +123,9 @@ Extent bounding_box(const MeshView& m) {
 // at the target of the face's halfedge), read once for all the geometric checks. A
 // deleted face has an empty cycle.
 struct FaceCycles {
-  std::vector<int> begin;     // size F + 1, over all faces
-  std::vector<int> vertex;    // corner k of face f: vertex[begin[f] + k]
-  std::vector<int> across;    // the face across the edge that ends at corner k (if any)
+  std::vector<int> begin;   // size F + 1, over all faces
+  std::vector<int> vertex;  // corner k of face f: vertex[begin[f] + k]
+  std::vector<int> across;  // the face across the edge that ends at corner k (if any)
   int degree(int f) const { return begin[f + 1] - begin[f]; }
   const int* corners(int f) const { return vertex.data() + begin[f]; }
 };
@@ -429,11 +429,10 @@ Finding planar_and_convex(const MeshView& m, double relative_tolerance, const Ge
     const int* corners = cycles.corners(f);
     int k = 0;
     while (std::abs(height(plane, m.points[corners[k]])) <= tolerance) ++k;
-    return fail(Verdict::not_convex,
-                "face " + std::to_string(f) + " is not planar: vertex " +
-                    std::to_string(corners[k]) + " is " +
-                    number(std::abs(height(plane, m.points[corners[k]]))) +
-                    " from its plane (tolerance " + number(tolerance) + ")");
+    return fail(Verdict::not_convex, "face " + std::to_string(f) + " is not planar: vertex " +
+                                         std::to_string(corners[k]) + " is " +
+                                         number(std::abs(height(plane, m.points[corners[k]]))) +
+                                         " from its plane (tolerance " + number(tolerance) + ")");
   }
   if (!geometry.reflex) return {};
   for (int e = 0; e < m.n_edges; ++e) {
