@@ -24,7 +24,7 @@ using morph::Point;
 using morph::detail::FaceOrder;
 using morph::detail::Polytope;
 
-// The first difference between two polytopes (every array, labels and interval normals),
+// The first difference between two polytopes (every array, labels and unit normals),
 // or "" when they are the same.
 std::string difference(const Polytope& a, const Polytope& b) {
   const auto same_points = [](const auto& x, const auto& y) {
@@ -49,13 +49,9 @@ std::string difference(const Polytope& a, const Polytope& b) {
   if (a.vertex_source != b.vertex_source) return "vertex_source";
   if (a.face_source != b.face_source) return "face_source";
   if (a.edge_source != b.edge_source) return "edge_source";
-  const auto same_interval = [](const auto& x, const auto& y) {
-    return x.inf() == y.inf() && x.sup() == y.sup();
-  };
   for (int f = 0; f < a.num_faces(); ++f) {
-    const auto &n = a.normals[f], &m = b.normals[f];
-    if (!same_interval(n.x, m.x) || !same_interval(n.y, m.y) || !same_interval(n.z, m.z))
-      return "normals";
+    const auto &n = a.unit_normals[f], &m = b.unit_normals[f];
+    if (n.x != m.x || n.y != m.y || n.z != m.z || n.error != m.error) return "normals";
   }
   return "";
 }
@@ -278,4 +274,59 @@ TEST_CASE("polytope: two triangles a hair from coplanar stay apart when convex, 
     CHECK(p.num_vertices() == 8);
     check_both_paths(mesh, "bent cube");
   }
+}
+
+namespace {
+
+// Whether unit normal u lies within u.error of the direction of the exact normal n, decided
+// exactly: |u - n/|n||^2 <= e^2 <=> 2 u.n >= s |n| with s = |u|^2 + 1 - e^2 (u, e doubles).
+bool within_error(const morph::detail::UnitNormal& u,
+                  const morph::detail::V3<morph::detail::ExactN>& n) {
+  using morph::detail::ExactN;
+  if (!std::isfinite(u.error)) return true;
+  const ExactN x(u.x), y(u.y), z(u.z), e(u.error);
+  const ExactN un = x * n.x + y * n.y + z * n.z;
+  const ExactN s = x * x + y * y + z * z + ExactN(1) - e * e;
+  const ExactN nn = n.x * n.x + n.y * n.y + n.z * n.z;
+  const ExactN lhs = ExactN(4) * un * un, rhs = s * s * nn;
+  const int su = CGAL::sign(un), ss = CGAL::sign(s);
+  if (ss <= 0) return su >= 0 || CGAL::sign(lhs - rhs) <= 0;
+  return su > 0 && CGAL::sign(lhs - rhs) >= 0;
+}
+
+void check_unit_normals(const Mesh& mesh, const std::string& what) {
+  CAPTURE(what);
+  const Polytope p = morph::detail::make_polytope(mesh, "A");
+  for (int f = 0; f < p.num_faces(); ++f) {
+    CAPTURE(f);
+    const auto& u = p.unit_normals[f];
+    CHECK(within_error(u, p.exact_normal(f)));
+    CHECK(u.error < 1e-12);  // the bound is tight enough to decide well-shaped facets
+  }
+}
+
+}  // namespace
+
+TEST_CASE("polytope: unit normals lie within their error bounds of the exact directions") {
+  for (const auto& entry : std::filesystem::directory_iterator(MORPH_SAMPLES_DIR)) {
+    if (entry.path().extension() != ".off") continue;
+    const std::string name = entry.path().filename().string();
+    const Mesh mesh = morph::read_mesh(entry.path().string());
+    check_unit_normals(mesh, name);
+    check_unit_normals(morph::test::transformed(mesh, morph::test::random_rotation(5)),
+                       name + " rotated");
+    check_unit_normals(morph::test::scaled(mesh, 0x1p-200), name + " tiny");
+    check_unit_normals(morph::test::scaled(mesh, 0x1p200), name + " huge");
+  }
+  // Far from the origin the Newell sum cancels a lot: the bound must follow.
+  const Mesh sphere = morph::read_mesh(std::string(MORPH_SAMPLES_DIR) + "/icosphere_1280.off");
+  check_unit_normals(morph::test::translated(sphere, Point(1e6, -3e5, 7)), "far sphere");
+}
+
+TEST_CASE("polytope: a within_error oracle that can fail") {
+  const morph::detail::V3<morph::detail::ExactN> n{1, 0, 0};
+  CHECK(within_error({1, 0, 0, 0}, n));
+  CHECK(within_error({1, 1e-10, 0, 1.1e-10}, n));
+  CHECK_FALSE(within_error({1, 1e-10, 0, 0.9e-10}, n));
+  CHECK_FALSE(within_error({-1, 0, 0, 1.9}, n));
 }

@@ -200,42 +200,88 @@ const PreciseNormal& Polytope::precise_normal(int f) const {
   });
 }
 
+namespace {
+
+constexpr double kUlp = 0x1p-52;  // one ulp relative to the result: any rounding mode
+
+/// The unit vector of m (non-zero, finite) with a bound on its distance to the direction
+/// of any vector within `radius` of m: 2 radius / |m| (the normalisation adds a few ulps;
+/// margins cover the rounding of |m| and of the bound). Far from 1, both are first scaled by
+/// a power of two (exactly) so that |m|^2 neither overflows nor underflows. Infinite error when m
+/// does not tell a direction.
+inline UnitNormal normalised(V3<double> m, double radius) {
+  const double largest = std::max({std::abs(m.x), std::abs(m.y), std::abs(m.z)});
+  if (!(largest > 0) || !std::isfinite(largest) || !std::isfinite(radius))
+    return {0, 0, 0, std::numeric_limits<double>::infinity()};
+  if (!(largest > 1e-100 && largest < 1e100)) {
+    const double scale = std::ldexp(1.0, -std::ilogb(largest));
+    m = {m.x * scale, m.y * scale, m.z * scale};
+    radius *= scale;
+  }
+  const double inverse = 1 / std::sqrt(dot(m, m));
+  double error = 2 * radius * inverse * (1 + 1e-10) + 4e-15;
+  if (!std::isfinite(error) || error > 1) error = std::numeric_limits<double>::infinity();
+  return {m.x * inverse, m.y * inverse, m.z * inverse, error};
+}
+
+/// Facet f's Newell normal computed in doubles from its double points, as a sum of cross
+/// products of the corners relative to the first, a_k = p_k - p_0 (the same polynomial:
+/// Newell's sum is translation invariant, and the terms at a_0 = 0 vanish), with a bound
+/// on each component's error. Rounding each difference, product and sum within one ulp
+/// (any rounding mode), a term a_j b_l - a_l b_j errs by at most 4 ulps of
+/// |a_j b_l| + |a_l b_j| and each of the d - 3 additions by one ulp of the sum of those:
+/// (d + 1) ulps of M in all, taken as (d + 2) with a margin for M's own rounding, plus
+/// an absolute term for underflow.
+UnitNormal unit_newell(const std::vector<V3<double>>& points, const int* corners, int d) {
+  const V3<double>& o = points[corners[0]];
+  V3<double> sum{0, 0, 0}, magnitude{0, 0, 0};
+  V3<double> a = points[corners[1]] - o;
+  for (int k = 2; k < d; ++k) {
+    const V3<double> b = points[corners[k]] - o;
+    const double xy = a.y * b.z, xz = a.z * b.y, yz = a.z * b.x, yx = a.x * b.z, zx = a.x * b.y,
+                 zy = a.y * b.x;
+    sum.x += xy - xz;
+    sum.y += yz - yx;
+    sum.z += zx - zy;
+    magnitude.x += std::abs(xy) + std::abs(xz);
+    magnitude.y += std::abs(yz) + std::abs(yx);
+    magnitude.z += std::abs(zx) + std::abs(zy);
+    a = b;
+  }
+  const double factor = (d + 2) * kUlp * 1.01, absolute = d * 0x1p-1000;
+  // The bound of each component, summed: a bound on the Euclidean distance.
+  return normalised(sum,
+                    (factor * (magnitude.x + magnitude.y + magnitude.z) + 3 * absolute) * 1.01);
+}
+
+/// The unit normal of an interval enclosure n of a facet's Newell normal: its midpoint m,
+/// within the box's half-diagonal of the exact normal (the width sums, rounded upwards
+/// under the caller's RoundingGuard, bound the half-diagonal).
+UnitNormal unit_of_enclosure(const V3<Interval>& n) {
+  const V3<double> m{0.5 * (n.x.inf() + n.x.sup()), 0.5 * (n.y.inf() + n.y.sup()),
+                     0.5 * (n.z.inf() + n.z.sup())};
+  const double width = (n.x.sup() - n.x.inf()) + (n.y.sup() - n.y.inf()) + (n.z.sup() - n.z.inf());
+  return normalised(m, width * 1.01);
+}
+
+}  // namespace
+
 void Polytope::compute_normals() {
   const int nf = num_faces();
-  normals.resize(nf);
-  RoundingGuard guard;
+  unit_normals.resize(nf);
   if (exact_points.empty()) {
-    for (int f = 0; f < nf; ++f) {
-      const int* corners = &corner_vertex[face_begin[f]];
-      normals[f] = newell_normal<Interval>(degree(f),
-                                           [&](int i) { return to_interval(points[corners[i]]); });
-    }
+    for (int f = 0; f < nf; ++f)
+      unit_normals[f] = unit_newell(points, &corner_vertex[face_begin[f]], degree(f));
   } else {
+    RoundingGuard guard;
     std::vector<V3<Interval>> cycle;  // conversions from rationals are worth caching
     for (int f = 0; f < nf; ++f) {
       const int b = face_begin[f];
       cycle.clear();
       for (int k = 0; k < degree(f); ++k) cycle.push_back(interval_point(corner_vertex[b + k]));
-      normals[f] = newell_normal<Interval>(degree(f),
-                                           [&](int i) -> const V3<Interval>& { return cycle[i]; });
+      unit_normals[f] = unit_of_enclosure(newell_normal<Interval>(
+          degree(f), [&](int i) -> const V3<Interval>& { return cycle[i]; }));
     }
-  }
-  // Unit vectors: the midpoint m of each enclosure, normalised. The exact normal n lies
-  // in the box, |n - m| <= r (its half-diagonal), hence |n/|n| - m/|m|| <= 2r/|m|; the
-  // normalisation adds a few ulps. Rounded upwards here, and with margins.
-  unit_normals.resize(nf);
-  for (int f = 0; f < nf; ++f) {
-    const V3<Interval>& n = normals[f];
-    const V3<double> m{0.5 * (n.x.inf() + n.x.sup()), 0.5 * (n.y.inf() + n.y.sup()),
-                       0.5 * (n.z.inf() + n.z.sup())};
-    const V3<double> r{n.x.sup() - n.x.inf(), n.y.sup() - n.y.inf(), n.z.sup() - n.z.inf()};
-    const double length = std::sqrt(dot(m, m));
-    const double radius = 0.5 * std::sqrt(dot(r, r));
-    double error = 2 * radius / length * (1 + 1e-10) + 4e-15;
-    if (!(length > 0) || !std::isfinite(error) || error > 1)
-      error = std::numeric_limits<double>::infinity();
-    unit_normals[f] = length > 0 ? UnitNormal{m.x / length, m.y / length, m.z / length, error}
-                                 : UnitNormal{0, 0, 0, error};
   }
   exact_cache_ = std::make_shared<LazySlots<V3<ExactN>>>(nf);
   precise_cache_ = std::make_shared<LazySlots<PreciseNormal>>(nf);
@@ -459,14 +505,44 @@ int triangle_edge_convexity(const Polytope& p, const Polytope::Edge& e) {
   return 2;
 }
 
+/// edge_convexity() decided on the unit normals when their error bounds allow, else 2.
+/// With unit normals a', b' within e_a, e_b of the exact ones' directions a, b (|a|, |b| =
+/// 1) and d' within r of d = to - from: |det(a', b', d') - det(a, b, d)| <= (e_a + e_b)
+/// |d'| + r, and the evaluation adds at most kUnitPredicateRounding |d'| (the unit bound,
+/// scaled); any rounding mode.
+int unit_edge_convexity(const Polytope& p, const Polytope::Edge& e) {
+  const UnitNormal &a = p.unit_normals[e.left], &b = p.unit_normals[e.right];
+  V3<double> d;
+  double radius;
+  if (p.exact_points.empty()) {
+    d = p.points[e.to] - p.points[e.from];  // each component within an ulp
+    radius = (std::abs(d.x) + std::abs(d.y) + std::abs(d.z)) * 0x1p-52 * 1.01;
+  } else {
+    RoundingGuard guard;  // enclosures of the difference
+    const V3<Interval> di = p.interval_point(e.to) - p.interval_point(e.from);
+    d = {0.5 * (di.x.inf() + di.x.sup()), 0.5 * (di.y.inf() + di.y.sup()),
+         0.5 * (di.z.inf() + di.z.sup())};
+    radius =
+        ((di.x.sup() - di.x.inf()) + (di.y.sup() - di.y.inf()) + (di.z.sup() - di.z.inf())) * 1.01;
+  }
+  const double length = std::abs(d.x) + std::abs(d.y) + std::abs(d.z);  // >= |d'|
+  // Products must not underflow (the bound is relative), nor |d'| overflow.
+  if (!(length > 1e-250 && length < 1e250)) return 2;
+  const double value =
+      d.x * (a.y * b.z - a.z * b.y) + d.y * (a.z * b.x - a.x * b.z) + d.z * (a.x * b.y - a.y * b.x);
+  const double bound = ((a.error + b.error + kUnitPredicateRounding) * length + radius) * 1.01;
+  if (value > bound) return 1;
+  if (value < -bound) return -1;
+  return 2;
+}
+
 /// Sign of det(N_left, N_right, to - from): positive when the edge is strictly convex.
 int edge_convexity(const Polytope& p, const Polytope::Edge& e) {
+  // The unit normals decide all but nearly flat edges, reading less than the triangles.
+  if (const int s = unit_edge_convexity(p, e); s != 2) return s;
   if (p.exact_points.empty() && p.degree(e.left) == 3 && p.degree(e.right) == 3) {
     if (const int s = triangle_edge_convexity(p, e); s != 2) return s;
   }
-  const int s = interval_sign(det(p.normals[e.left], p.normals[e.right],
-                                  p.interval_point(e.to) - p.interval_point(e.from)));
-  if (s != 2) return s;
   if (p.exact_points.empty())
     return CGAL::sign(det(p.exact_normal(e.left), p.exact_normal(e.right),
                           to_exact_n(p.points[e.to]) - to_exact_n(p.points[e.from])));
@@ -488,10 +564,10 @@ void check_gauss_map(const Polytope& p, const char* name) {
     const int b = p.fan_begin[v], n = p.fan_begin[v + 1] - b;
     if (n < 3)
       fail(name, "vertex " + std::to_string(p.vertex_source[v]) + " has fewer than three facets");
-    for (int i = 0; i < n; ++i) {
-      const int s = orient_normals(NormalRef{&p, p.fan_face[b + i]},
-                                   NormalRef{&p, p.fan_face[b + (i + 1) % n]},
-                                   NormalRef{&p, p.fan_face[b + (i + 2) % n]});
+    for (int i = 0, j = 1, k = 2; i < n; ++i, j = k, k = k + 1 == n ? 0 : k + 1) {
+      const int s =
+          orient_normals(NormalRef{&p, p.fan_face[b + i]}, NormalRef{&p, p.fan_face[b + j]},
+                         NormalRef{&p, p.fan_face[b + k]});
       if (s <= 0)
         fail(name, "the facets around vertex " + std::to_string(p.vertex_source[v]) +
                        " do not turn convexly (the mesh is not convex)");
@@ -529,26 +605,39 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   const int nh = static_cast<int>(mesh.n_halfedges());
   const bool reversed = order == FaceOrder::reversed;
   // Corner c is halfedge corner_halfedge[c] of its face: leaving the corner's vertex when
-  // as given; when reversed, entering it (the facet runs against the halfedges).
-  std::vector<int> corner_halfedge(nh), corner_face(nh), corner_of(nh, -1);
+  // as given; when reversed, entering it (the facet runs against the halfedges). The
+  // temporaries are written before they are read: left uninitialised.
+  std::unique_ptr<int[]> corner_halfedge(new int[nh]);
+  std::vector<int> corner_of(nh, -1);
+  // What the fan walk reads of corner c, together: its facet, the previous corner of the
+  // facet, and the next corner counter-clockwise around its vertex (filled below).
+  struct FanLink {
+    int face, prev, next;
+  };
+  std::unique_ptr<FanLink[]> link(new FanLink[nh]);
   p.face_begin.resize(nf + 1);
   p.corner_vertex.resize(nh);
   int c = 0;
   for (int f = 0; f < nf; ++f) {
     p.face_begin[f] = c;
     const auto h0 = mesh.halfedge_handle(Mesh::FaceHandle(f));
-    // The face circulator starts at the target of h0.
+    // The face circulator starts at the target of h0. As given, a corner's vertex is the
+    // target of the halfedge before it (read with the link to the next one).
     const auto start = reversed ? mesh.prev_halfedge_handle(h0) : mesh.next_halfedge_handle(h0);
+    int from = mesh.to_vertex_handle(h0).idx();
     auto h = start;
     do {
       if (c == nh) throw error("internal error: a mesh face is not a closed cycle");
-      p.corner_vertex[c] = (reversed ? mesh.to_vertex_handle(h) : mesh.from_vertex_handle(h)).idx();
+      p.corner_vertex[c] = reversed ? mesh.to_vertex_handle(h).idx() : from;
       corner_halfedge[c] = h.idx();
-      corner_face[c] = f;
+      link[c].face = f;
+      link[c].prev = c - 1;
       corner_of[h.idx()] = c;
       ++c;
+      if (!reversed) from = mesh.to_vertex_handle(h).idx();
       h = reversed ? mesh.prev_halfedge_handle(h) : mesh.next_halfedge_handle(h);
     } while (h != start);
+    link[p.face_begin[f]].prev = c - 1;
   }
   p.face_begin[nf] = c;
   if (c != nh) throw error("internal error: a mesh halfedge has no face");
@@ -567,20 +656,16 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
     const int t = twin(c);
     if (t < c) continue;  // numbered at t
     const int e = static_cast<int>(p.edges.size());
-    p.edges.push_back({p.corner_vertex[c], p.corner_vertex[t], corner_face[c], corner_face[t]});
+    p.edges.push_back({p.corner_vertex[c], p.corner_vertex[t], link[c].face, link[t].face});
     mesh_edge.push_back(corner_halfedge[c] >> 1);
     p.corner_edge[c] = e;
     p.corner_edge[t] = e;
   }
 
   // Fans, walked as build_connectivity does: from the last corner at v, the next facet
-  // counter-clockwise is across the incoming edge u -> v, at corner fan_next[c] =
-  // twin(prev_corner(c)); precomputed so that the walk follows one link per step.
-  std::vector<int> fan_next(nc);
-  for (int f = 0; f < nf; ++f) {
-    const int b = p.face_begin[f], end = p.face_begin[f + 1];
-    for (c = b; c < end; ++c) fan_next[c] = twin(c == b ? end - 1 : c - 1);
-  }
+  // counter-clockwise is across the incoming edge u -> v, at corner twin(prev corner);
+  // precomputed so that the walk follows one link per step.
+  for (c = 0; c < nc; ++c) link[c].next = twin(link[c].prev);
   std::vector<int> some_corner(nv, -1);
   for (c = 0; c < nc; ++c) some_corner[p.corner_vertex[c]] = c;
   p.fan_begin.resize(nv + 1);
@@ -595,13 +680,12 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
     c = first;
     do {
       if (slot == nc) throw error("internal error: a mesh vertex has a broken fan");
-      const int f = corner_face[c];
-      const int pc = c == p.face_begin[f] ? p.face_begin[f + 1] - 1 : c - 1;
-      p.fan_face[slot] = f;
-      p.fan_edge[slot] = p.corner_edge[pc];
-      p.fan_vertex[slot] = p.corner_vertex[pc];
+      const FanLink& l = link[c];
+      p.fan_face[slot] = l.face;
+      p.fan_edge[slot] = p.corner_edge[l.prev];
+      p.fan_vertex[slot] = p.corner_vertex[l.prev];
       ++slot;
-      c = fan_next[c];
+      c = l.next;
     } while (c != first);
   }
   p.fan_begin[nv] = slot;

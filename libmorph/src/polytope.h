@@ -2,8 +2,9 @@
 //
 // A Polytope is built from a validated Mesh (or produced by an operation) and carries
 // what the exact algorithms need: facet cycles, edges with their two facets, the fan of
-// facets around each vertex, interval and (lazily) exact facet normals, and exact vertex
-// positions when they are not doubles (results of an erosion chained into a dilation).
+// facets around each vertex, unit (and, lazily, precise and exact) facet normals, and
+// exact vertex positions when they are not doubles (results of an erosion chained into a
+// dilation).
 //
 // Canonical form: adjacent facets whose common edge is not strictly convex (exactly
 // coplanar, or within the validation tolerance) are merged into one polygon, and
@@ -90,9 +91,7 @@ struct Polytope {
   std::vector<int> fan_begin;  // size V + 1
   std::vector<int> fan_face, fan_edge, fan_vertex;
 
-  // Interval Newell normals (computed under a RoundingGuard).
-  std::vector<V3<Interval>> normals;
-  // The same normals as unit double vectors with error bounds: the fast filter of every
+  // The facet normals as unit double vectors with error bounds: the fast filter of every
   // predicate on normals (see orient_normals).
   std::vector<UnitNormal> unit_normals;
 
@@ -117,8 +116,8 @@ struct Polytope {
   /// kept (thread-safe: racing threads may both compute it, all get the one kept).
   const V3<ExactN>& exact_normal(int f) const;
 
-  /// Computes `normals` and `unit_normals` and resets the caches of exact and precise
-  /// normals; call after the facets are final.
+  /// Computes `unit_normals` and resets the caches of exact and precise normals; call
+  /// after the facets are final.
   void compute_normals();
 
   /// Facet f's exact normal (the given one, or Newell's of the double points) in

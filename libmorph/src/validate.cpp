@@ -125,6 +125,7 @@ Extent bounding_box(const MeshView& m) {
 struct FaceCycles {
   std::vector<int> begin;   // size F + 1, over all faces
   std::vector<int> vertex;  // corner k of face f: vertex[begin[f] + k]
+  std::vector<int> across;  // the face across the edge that ends at corner k (if any)
   int degree(int f) const { return begin[f + 1] - begin[f]; }
   const int* corners(int f) const { return vertex.data() + begin[f]; }
 };
@@ -133,6 +134,7 @@ FaceCycles face_cycles(const MeshView& m) {
   FaceCycles cycles;
   cycles.begin.resize(m.n_faces + 1);
   cycles.vertex.reserve(m.n_halfedges);
+  cycles.across.reserve(m.n_halfedges);
   for (int f = 0; f < m.n_faces; ++f) {
     cycles.begin[f] = static_cast<int>(cycles.vertex.size());
     if (!m.live_face(f)) continue;
@@ -143,6 +145,7 @@ FaceCycles face_cycles(const MeshView& m) {
         throw error("internal error: mesh face " + std::to_string(f) +
                     " is not a closed cycle of halfedges");
       cycles.vertex.push_back(m.to(h));
+      cycles.across.push_back(m.face(h ^ 1));
       h = m.next(h);
     } while (h != first);
   }
@@ -169,15 +172,19 @@ Finding closed_manifold(const MeshView& m) {
   // A vertex is manifold when the faces around it form one fan: the circulator around
   // it (which walks one fan) must meet every halfedge leaving it, and reach each
   // neighbour once (two edges between the same vertices pinch the surface).
-  std::vector<int> outgoing(m.n_vertices, 0);
-  for (int h = 0; h < m.n_halfedges; ++h)
-    if (m.live_halfedge(h)) ++outgoing[m.from(h)];
   enum class Fan : char { unreached, queued, one, isolated, several, pinched };
-  // seen[w] == v: w was already reached from v (a stamp, so the array is never cleared).
-  std::vector<int> seen(m.n_vertices, -1);
+  // What the walks know of a vertex, kept together (a walk reads them for each neighbour).
+  struct VertexState {
+    int outgoing = 0;  // live halfedges leaving it
+    int seen = -1;     // == v: reached from v already (a stamp, never cleared)
+    Fan fan = Fan::unreached;
+  };
+  std::vector<VertexState> state(m.n_vertices);
+  for (int h = 0; h < m.n_halfedges; ++h)
+    if (m.live_halfedge(h)) ++state[m.from(h)].outgoing;
   // Walks the fan of v, calling visit(w) for each neighbour w it reaches.
   const auto walk_fan = [&](int v, const auto& visit) {
-    if (outgoing[v] == 0) return Fan::isolated;
+    if (state[v].outgoing == 0) return Fan::isolated;
     int reached = 0;
     bool pinched = false;
     // The outgoing halfedges around v, as the circulator walks them.
@@ -186,12 +193,12 @@ Finding closed_manifold(const MeshView& m) {
     do {
       const int w = m.to(h);
       visit(w);
-      pinched = pinched || seen[w] == v;
-      seen[w] = v;
-      if (++reached > outgoing[v]) break;  // corrupt links
+      pinched = pinched || state[w].seen == v;
+      state[w].seen = v;
+      if (++reached > state[v].outgoing) break;  // corrupt links
       h = m.next(h ^ 1);
     } while (h != first);
-    if (reached != outgoing[v]) return Fan::several;
+    if (reached != state[v].outgoing) return Fan::several;
     return pinched ? Fan::pinched : Fan::one;
   };
 
@@ -200,23 +207,22 @@ Finding closed_manifold(const MeshView& m) {
   // pass); then the vertices are judged in index order, as the rule lists them.
   int first = 0;
   while (first < m.n_vertices && !m.live_vertex(first)) ++first;
-  std::vector<Fan> fan(m.n_vertices, Fan::unreached);
   std::vector<int> stack;
   const auto reach = [&](int w) {
-    if (fan[w] != Fan::unreached) return;
-    fan[w] = Fan::queued;
+    if (state[w].fan != Fan::unreached) return;
+    state[w].fan = Fan::queued;
     stack.push_back(w);
   };
   if (first < m.n_vertices) reach(first);
   while (!stack.empty()) {
     const int v = stack.back();
     stack.pop_back();
-    fan[v] = walk_fan(v, reach);
+    state[v].fan = walk_fan(v, reach);
   }
   for (int v = 0; v < m.n_vertices; ++v) {
     if (!m.live_vertex(v)) continue;
     ++n_vertices;
-    const Fan found = fan[v] == Fan::unreached ? walk_fan(v, [](int) {}) : fan[v];
+    const Fan found = state[v].fan == Fan::unreached ? walk_fan(v, [](int) {}) : state[v].fan;
     if (found == Fan::isolated)
       return fail(Verdict::invalid,
                   "vertex " + std::to_string(v) + " is isolated (it belongs to no face)");
@@ -236,7 +242,7 @@ Finding closed_manifold(const MeshView& m) {
     }
   }
   for (int v = first + 1; v < m.n_vertices; ++v)
-    if (m.live_vertex(v) && fan[v] == Fan::unreached)
+    if (m.live_vertex(v) && state[v].fan == Fan::unreached)
       return fail(Verdict::invalid, "the mesh is not connected: vertex " + std::to_string(v) +
                                         " is not connected to vertex " + std::to_string(first));
 
@@ -304,16 +310,36 @@ FanVolumes fan_volumes(const MeshView& m, const FaceCycles& cycles, const Point&
 }
 
 // What the geometric checks share, gathered in one pass over the faces by
-// nondegenerate(): the extent, the face cycles and unit planes, the fan volumes about the
-// extent's centre, and the first face that is not planar (reported only after the
-// orientation, as the rule orders them).
+// nondegenerate(): the extent, the face cycles, the fan volumes about the extent's
+// centre, the first face that is not planar and whether any edge may be reflex (both
+// reported only after the orientation, as the rule orders them).
 struct Geometry {
   Extent extent;
   FaceCycles cycles;
-  std::vector<FacePlane> planes;  // by face index
   FanVolumes volumes;
   int non_planar_face = -1;
+  bool reflex = false;  // some vertex lies above the plane of a neighbouring face
 };
+
+// The plane of face f with its unit normal (the face is known to be non-degenerate).
+FacePlane unit_plane(const MeshView& m, const FaceCycles& cycles, int f) {
+  FacePlane plane = newell_plane(m.points, cycles.corners(f), cycles.degree(f));
+  plane.normal *= 1.0 / plane.normal.norm();
+  return plane;
+}
+
+// Whether a vertex of face g across f's edge from -> to (other than the edge's ends, which
+// passed f's planarity check) lies above f's plane by more than the tolerance.
+bool reflex_across(const MeshView& m, const FaceCycles& cycles, const FacePlane& plane, int g,
+                   int from, int to, double tolerance) {
+  const int* corners = cycles.corners(g);
+  for (int k = 0; k < cycles.degree(g); ++k) {
+    const int v = corners[k];
+    if (v == from || v == to) continue;
+    if (!(height(plane, m.points[v]) <= tolerance)) return true;
+  }
+  return false;
+}
 
 // Whether two of the n values key(0), ..., key(n - 1) are equal (quadratic: faces are
 // small; sorting would allocate).
@@ -326,8 +352,10 @@ bool has_equal_pair(int n, const Key& key) {
 }
 
 // Fills `geometry` for the later checks when the mesh passes; planarity is judged with
-// `relative_tolerance` times the bounding-box diagonal.
-Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& geometry) {
+// `relative_tolerance` times the bounding-box diagonal. With `convexity` (only for a closed
+// mesh), also whether any edge may be reflex, with each face's plane while it is at hand.
+Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& geometry,
+                      bool convexity = false) {
   for (int v = 0; v < m.n_vertices; ++v) {
     if (!m.live_vertex(v)) continue;
     const Point& p = m.points[v];
@@ -343,7 +371,6 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
                                       number(kMaxSize) + "]");
   const double tolerance = relative_tolerance * diagonal;
   geometry.cycles = face_cycles(m);
-  geometry.planes.resize(m.n_faces);
   for (int f = 0; f < m.n_faces; ++f) {
     if (!m.live_face(f)) continue;
     const int* ids = geometry.cycles.corners(f);
@@ -359,8 +386,7 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
       return fail(Verdict::invalid,
                   face() + " uses vertex " + std::to_string(*twice) + " more than once");
     }
-    FacePlane& plane = geometry.planes[f];
-    plane = newell_plane(m.points, ids, n);
+    FacePlane plane = newell_plane(m.points, ids, n);
     if (has_equal_pair(n, [&](int i) -> const Point& { return m.points[ids[i]]; }))
       return fail(Verdict::invalid, face() + " has two vertices at the same position");
     const double length = plane.normal.norm();
@@ -370,6 +396,12 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
     geometry.volumes.add_face(m.points, ids, n, geometry.extent.centre);
     for (int k = 0; k < n && geometry.non_planar_face < 0; ++k)
       if (!(std::abs(height(plane, m.points[ids[k]])) <= tolerance)) geometry.non_planar_face = f;
+    if (convexity && !geometry.reflex) {
+      const int* across = geometry.cycles.across.data() + geometry.cycles.begin[f];
+      for (int k = 0; k < n && !geometry.reflex; ++k)
+        geometry.reflex = reflex_across(m, geometry.cycles, plane, across[k],
+                                        ids[k == 0 ? n - 1 : k - 1], ids[k], tolerance);
+    }
   }
   return {};
 }
@@ -387,26 +419,28 @@ Finding outward(const FanVolumes& volumes) {
   return {Verdict::ok, {}, volume};
 }
 
-// Planarity (found by nondegenerate()), then edge convexity.
+// Planarity, then edge convexity (both found by nondegenerate(); here the first offender
+// in the rule's order is named).
 Finding planar_and_convex(const MeshView& m, double relative_tolerance, const Geometry& geometry) {
   const double tolerance = relative_tolerance * geometry.extent.diagonal;
   const FaceCycles& cycles = geometry.cycles;
   if (const int f = geometry.non_planar_face; f >= 0) {
+    const FacePlane plane = unit_plane(m, cycles, f);
     const int* corners = cycles.corners(f);
     int k = 0;
-    while (std::abs(height(geometry.planes[f], m.points[corners[k]])) <= tolerance) ++k;
-    return fail(Verdict::not_convex,
-                "face " + std::to_string(f) + " is not planar: vertex " +
-                    std::to_string(corners[k]) + " is " +
-                    number(std::abs(height(geometry.planes[f], m.points[corners[k]]))) +
-                    " from its plane (tolerance " + number(tolerance) + ")");
+    while (std::abs(height(plane, m.points[corners[k]])) <= tolerance) ++k;
+    return fail(Verdict::not_convex, "face " + std::to_string(f) + " is not planar: vertex " +
+                                         std::to_string(corners[k]) + " is " +
+                                         number(std::abs(height(plane, m.points[corners[k]]))) +
+                                         " from its plane (tolerance " + number(tolerance) + ")");
   }
+  if (!geometry.reflex) return {};
   for (int e = 0; e < m.n_edges; ++e) {
     if (!m.live_edge(e)) continue;
     for (int side = 0; side < 2; ++side) {
       const int h = 2 * e + side;
       const int f = m.face(h), g = m.face(h ^ 1);
-      const FacePlane& plane = geometry.planes[f];
+      const FacePlane plane = unit_plane(m, cycles, f);
       // The edge's own vertices belong to f and passed the planarity check: their height
       // is at most the tolerance, so only g's other vertices can fail.
       const int from = m.from(h), to = m.to(h);
@@ -433,7 +467,8 @@ Finding convex_polyhedron(const Mesh& mesh, double relative_tolerance) {
   const MeshView m(mesh);
   if (Finding found = closed_manifold(m); found.verdict != Verdict::ok) return found;
   Geometry geometry;
-  if (Finding found = nondegenerate(m, relative_tolerance, geometry); found.verdict != Verdict::ok)
+  if (Finding found = nondegenerate(m, relative_tolerance, geometry, true);
+      found.verdict != Verdict::ok)
     return found;
   if (Finding found = outward(geometry.volumes); found.verdict != Verdict::ok) return found;
   return planar_and_convex(m, relative_tolerance, geometry);
