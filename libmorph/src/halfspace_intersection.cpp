@@ -843,33 +843,51 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
   return std::move(*built);
 }
 
+namespace {
+
+/// <n, p> for a vertex p = X / W of a polytope, as value / weight (weight > 0).
+struct Homogeneous {
+  ExactN value, weight;
+};
+Homogeneous homogeneous_dot(const Polytope& P, const V3<ExactN>& n, int v) {
+  if (P.exact_points.empty()) return {dot(n, to_exact_n(P.points[v])), ExactN(1)};
+  return {dot(n, P.exact_points.numerator[v]), P.exact_points.denominator[v]};
+}
+
+}  // namespace
+
 MaybePolytope erode_polytope(const Polytope& A, const Polytope& B,
                              const IntersectOptions& options) {
   const std::vector<Location> loc = locate_all(A, B);
   const int nf = A.num_faces();
   std::vector<HalfSpace> hs(nf);
-  const bool dyadic = A.exact_points.empty() && B.exact_points.empty();
   parallel_chunks(nf, 64, [&](int begin, int end) {
     for (int f = begin; f < end; ++f) {
       const V3<ExactN>& n = A.exact_normal(f);
       const int b = location_vertex(B, loc[f]);
-      if (dyadic) {
-        // Double points: every product is exact in Mpzf, no rationals needed.
-        // A triangle holds its corners exactly on the plane of its Newell normal.
-        const int corners = A.degree(f) == 3 && A.given_normals.empty() ? 1 : A.degree(f);
-        ExactN offset = dot(n, to_exact_n(A.points[A.corner(f, 0)]));
-        for (int k = 1; k < corners; ++k)
-          offset = std::max(offset, dot(n, to_exact_n(A.points[A.corner(f, k)])));
-        hs[f] = {n, offset - dot(n, to_exact_n(B.points[b])), ExactN(1), A.face_source[f],
-                 B.vertex_source[b]};
-      } else {
-        const V3<Exact> nr = to_rational(n);
-        Exact offset = dot(nr, A.exact_point(A.corner(f, 0)));
-        for (int k = 1; k < A.degree(f); ++k)
-          offset = std::max(offset, dot(nr, A.exact_point(A.corner(f, k))));
-        hs[f] = make_halfspace(n, offset - dot(nr, B.exact_point(b)), A.face_source[f]);
-        hs[f].element = B.vertex_source[b];
+      // h_A(N_f) = max over f's corners of <n, X> / W, compared by cross-multiplication
+      // (W > 0; W = 1 for double points, and for the exact sums of a closing): no
+      // rationals, no gcd. A triangle of double points holds its corners exactly on the
+      // plane of its Newell normal.
+      const int corners =
+          A.degree(f) == 3 && A.exact_points.empty() && A.given_normals.empty() ? 1 : A.degree(f);
+      Homogeneous best = homogeneous_dot(A, n, A.corner(f, 0));
+      for (int k = 1; k < corners; ++k) {
+        Homogeneous h = homogeneous_dot(A, n, A.corner(f, k));
+        if (h.value * best.weight > best.value * h.weight) best = std::move(h);
       }
+      // h_A - h_B = (p V - q W) / (W V) for h_A = p / W, h_B = q / V.
+      const Homogeneous hb = homogeneous_dot(B, n, b);
+      HalfSpace& h = hs[f];
+      h.normal = n;
+      if (best.weight == 1 && hb.weight == 1) {
+        h.offset = best.value - hb.value;
+      } else {
+        h.offset = best.value * hb.weight - hb.value * best.weight;
+        h.denominator = best.weight * hb.weight;
+      }
+      h.source = A.face_source[f];
+      h.element = B.vertex_source[b];
     }
   });
   // A point usually inside: A's vertex centroid minus B's.
