@@ -14,6 +14,10 @@
 // the exact route computes the dual hull on exact rational points (CGAL). Both routes end
 // in the same exact, canonical construction; vertices are rounded exactly from their
 // homogeneous coordinates, and rationals are formed only for a polytope chained further.
+// Incidences the caller knows (KnownPoints: an erosion's facets of A around a vertex moved
+// by one vertex of B) make vertices without exact constructions and zero tests free, and
+// an expected result (ExpectedVertices: a closing's A) replaces the hull when it passes
+// the check.
 #include "halfspace_intersection.h"
 
 #include <CGAL/Lazy_kernel.h>
@@ -936,6 +940,12 @@ Homogeneous homogeneous_dot(const Polytope& P, const V3<ExactN>& n, int v) {
   if (P.exact_points.empty()) return {dot(n, to_exact_n(P.points[v])), ExactN(1)};
   return {dot(n, P.exact_points.numerator[v]), P.exact_points.denominator[v]};
 }
+/// Sign of p - q, by cross-multiplication unless both weights are 1.
+int compare(const Homogeneous& p, const Homogeneous& q) {
+  if (p.weight == 1 && q.weight == 1) return CGAL::compare(p.value, q.value);
+  return CGAL::compare(p.value * q.weight, q.value * p.weight);
+}
+bool same(const Homogeneous& p, const Homogeneous& q) { return compare(p, q) == 0; }
 
 }  // namespace
 
@@ -962,10 +972,11 @@ void candidate_vertices(const Polytope& B, const Location& loc, std::vector<int>
 
 /// The known points of an erosion: facet f of A passes, after moving, through v - b for
 /// each corner v of f on its plane (`on_plane`, per corner of A) and each vertex b of B
-/// attaining h_B(N_f) (attaining[f]). Points are numbered by (v, b), or for a sum
+/// attaining h_B(N_f) (contributing[f], and others[f] when there are more). Points are numbered by (v, b), or for a sum
 /// A = X (+) B by the vertex of X when b is v's own summand (v - b is then that vertex of X).
 KnownPoints erosion_points(const Polytope& A, const Polytope& B,
-                           const std::vector<std::vector<int>>& attaining,
+                           const std::vector<int>& contributing,
+                           const std::vector<std::vector<int>>& others,
                            const std::vector<char>& on_plane) {
   KnownPoints known;
   if (!B.exact_points.empty()) return known;
@@ -987,7 +998,8 @@ KnownPoints erosion_points(const Polytope& A, const Polytope& B,
       if (!on_plane[A.face_begin[f] + k]) continue;
       const int v = A.corner(f, k);
       const std::uint64_t pair = sum ? A.sum_pairs[A.vertex_source[v]] : 0;
-      for (int b : attaining[f]) {
+      for (int i = -1; i < static_cast<int>(others[f].size()); ++i) {
+        const int b = i < 0 ? contributing[f] : others[f][i];
         const bool own = sum && pair_second(pair) == b;
         int& first = own ? head_x[pair_first(pair)] : head[v];
         int point = -1;
@@ -1004,7 +1016,24 @@ KnownPoints erosion_points(const Polytope& A, const Polytope& B,
     }
     known.begin[f + 1] = static_cast<int>(known.point.size());
   }
-  const int np = static_cast<int>(creator.size());
+  // Only a point on three planes or more can be a vertex: the others are dropped.
+  std::vector<int> count(creator.size(), 0);
+  for (int k : known.point) ++count[k];
+  std::vector<int> renumber(creator.size(), -1);
+  int np = 0;
+  for (std::size_t k = 0; k < creator.size(); ++k)
+    if (count[k] >= 3) {
+      renumber[k] = np;
+      creator[np++] = creator[k];
+    }
+  creator.resize(np);
+  int kept = 0;
+  for (int f = 0, j = 0; f < nf; ++f) {
+    for (; j < known.begin[f + 1]; ++j)
+      if (renumber[known.point[j]] >= 0) known.point[kept++] = renumber[known.point[j]];
+    known.begin[f + 1] = kept;
+  }
+  known.point.resize(kept);
   known.X.resize(np);
   known.W.resize(np);
   known.Xi.resize(np);
@@ -1039,7 +1068,8 @@ MaybePolytope erode(const Polytope& A, const Polytope& B, const IntersectOptions
   const int nf = A.num_faces();
   std::vector<HalfSpace> hs(nf);
   std::vector<char> on_plane(A.corner_vertex.size(), 0);  // per corner of A
-  std::vector<std::vector<int>> attaining(nf);             // vertices of B attaining h_B(N_f)
+  std::vector<int> contributing(nf);                       // the vertex of B moving f
+  std::vector<std::vector<int>> others(nf);  // more vertices of B attaining h_B(N_f)
   parallel_chunks(nf, 64, [&](int begin, int end) {
     std::vector<Homogeneous> dots;
     std::vector<int> candidates;
@@ -1059,22 +1089,17 @@ MaybePolytope erode(const Polytope& A, const Polytope& B, const IntersectOptions
         dots.clear();
         for (int k = 0; k < A.degree(f); ++k) {
           dots.push_back(homogeneous_dot(A, n, A.corner(f, k)));
-          if (dots[k].value * dots[best].weight > dots[best].value * dots[k].weight) best = k;
+          if (compare(dots[k], dots[best]) > 0) best = k;
         }
-        for (int k = 0; k < A.degree(f); ++k)
-          on[k] = dots[k].value * dots[best].weight == dots[best].value * dots[k].weight;
+        for (int k = 0; k < A.degree(f); ++k) on[k] = same(dots[k], dots[best]);
       }
       const Homogeneous& top = dots[best];
       // h_A - h_B = (p V - q W) / (W V) for h_A = p / W, h_B = q / V.
       const Homogeneous hb = homogeneous_dot(B, n, b);
+      contributing[f] = b;
       candidate_vertices(B, loc[f], candidates);
       for (int c : candidates) {
-        if (c == b) {
-          attaining[f].push_back(c);
-        } else {
-          const Homogeneous hc = homogeneous_dot(B, n, c);
-          if (hc.value * hb.weight == hb.value * hc.weight) attaining[f].push_back(c);
-        }
+        if (c != b && same(homogeneous_dot(B, n, c), hb)) others[f].push_back(c);
       }
       HalfSpace& h = hs[f];
       h.normal = n;
@@ -1088,7 +1113,7 @@ MaybePolytope erode(const Polytope& A, const Polytope& B, const IntersectOptions
       h.element = B.vertex_source[b];
     }
   });
-  const KnownPoints known = erosion_points(A, B, attaining, on_plane);
+  const KnownPoints known = erosion_points(A, B, contributing, others, on_plane);
   // A point usually inside: A's vertex centroid minus B's.
   V3<double> ca{0, 0, 0}, cb{0, 0, 0};
   for (const auto& p : A.points) ca = ca + p;
