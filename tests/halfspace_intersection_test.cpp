@@ -35,6 +35,25 @@ std::vector<HalfSpace> cube_planes(double r) {
   return hs;
 }
 
+/// A point that is not a double: (1/3, 1/5, 1/7).
+V3<Exact> rational_apex() {
+  return {Exact(1) / Exact(3), Exact(1) / Exact(5), Exact(1) / Exact(7)};
+}
+
+/// The cube [-2, 2]^3 and k planes tilted around the z axis, all exactly through
+/// rational_apex() (a cone's apex).
+std::vector<HalfSpace> planes_through_apex(int k) {
+  const V3<Exact> apex = rational_apex();
+  std::vector<HalfSpace> hs = cube_planes(2.0);
+  for (int i = 0; i < k; ++i) {
+    const double t = 2 * M_PI * i / k;
+    const V3<double> n{std::cos(t), std::sin(t), 0.75};
+    hs.push_back(
+        make_halfspace(to_exact_n(n), dot(to_exact(n), apex), static_cast<int>(hs.size())));
+  }
+  return hs;
+}
+
 /// First difference between two results (exact positions, facet cycles, labels), or "".
 std::string difference(const MaybePolytope& got, const MaybePolytope& want) {
   if (got.reason != want.reason) return "different emptiness";
@@ -133,15 +152,9 @@ TEST_CASE("halfspace_intersection: planes through one vertex are grouped exactly
 // Many planes exactly through one rational point (not a double): in doubles their dual
 // points are not coplanar, exactly they are. The apex must come out as one exact vertex.
 TEST_CASE("halfspace_intersection: many planes through a rational apex") {
-  const V3<Exact> apex{Exact(1) / Exact(3), Exact(1) / Exact(5), Exact(1) / Exact(7)};
+  const V3<Exact> apex = rational_apex();
   for (int k : {5, 12, 40}) {
-    std::vector<HalfSpace> hs = cube_planes(2.0);
-    for (int i = 0; i < k; ++i) {
-      const double t = 2 * M_PI * i / k;
-      const V3<double> n{std::cos(t), std::sin(t), 0.75};
-      hs.push_back(
-          make_halfspace(to_exact_n(n), dot(to_exact(n), apex), static_cast<int>(hs.size())));
-    }
+    const std::vector<HalfSpace> hs = planes_through_apex(k);
     const MaybePolytope r = checked(hs);
     REQUIRE(r.polytope);
     int found = 0;
@@ -210,15 +223,7 @@ TEST_CASE("halfspace_intersection: exact vertices plus doubles round as their ra
     const double got = round_quotient(X, W, Interval(estimate));
     return std::memcmp(&got, &want, sizeof got) == 0;  // also tells 0 from -0
   };
-  const V3<Exact> apex{Exact(1) / Exact(3), Exact(1) / Exact(5), Exact(1) / Exact(7)};
-  std::vector<HalfSpace> hs = cube_planes(2.0);
-  for (int i = 0; i < 12; ++i) {
-    const double t = 2 * M_PI * i / 12;
-    const V3<double> n{std::cos(t), std::sin(t), 0.75};
-    hs.push_back(
-        make_halfspace(to_exact_n(n), dot(to_exact(n), apex), static_cast<int>(hs.size())));
-  }
-  const MaybePolytope r = checked(hs);
+  const MaybePolytope r = checked(planes_through_apex(12));
   REQUIRE(r.polytope);
   const Polytope& p = *r.polytope;
   REQUIRE(!p.exact_points.empty());
@@ -250,14 +255,8 @@ TEST_CASE("halfspace_intersection: exact vertices plus doubles round as their ra
 // Known points (planes through one point) and an expected result only save work: the
 // intersection is the same, exactly, and a wrong guess is caught by the check.
 TEST_CASE("halfspace_intersection: known points and an expected result give the same result") {
-  const V3<Exact> apex{Exact(1) / Exact(3), Exact(1) / Exact(5), Exact(1) / Exact(7)};
-  std::vector<HalfSpace> hs = cube_planes(2.0);
-  for (int i = 0; i < 12; ++i) {
-    const double t = 2 * M_PI * i / 12;
-    const V3<double> n{std::cos(t), std::sin(t), 0.75};
-    hs.push_back(
-        make_halfspace(to_exact_n(n), dot(to_exact(n), apex), static_cast<int>(hs.size())));
-  }
+  const V3<Exact> apex = rational_apex();
+  std::vector<HalfSpace> hs = planes_through_apex(12);
   const MaybePolytope plain = checked(hs);
   REQUIRE(plain.polytope);
   // The apex as X / W = (35, 21, 15) / 105, on the twelve tilted planes.
@@ -301,8 +300,7 @@ TEST_CASE("halfspace_intersection: a closing's expected result") {
   const auto sample = [](const std::string& name) {
     return morph::read_mesh(std::string(MORPH_SAMPLES_DIR) + "/" + name);
   };
-  const Polytope B =
-      make_operand(morph::test::scaled(sample("icosphere_80.off"), 0.25), "B");
+  const Polytope B = make_operand(morph::test::scaled(sample("icosphere_80.off"), 0.25), "B");
   for (const char* name : {"icosphere_320.off", "cube.off", "uvsphere_1600.off"}) {
     INFO(name);
     const Polytope A = make_operand(sample(name), "A");

@@ -36,8 +36,8 @@
 #include <cstring>
 #include <deque>
 #include <map>
-#include <unordered_map>
 #include <numeric>
+#include <unordered_map>
 
 #include "fims.h"
 #include "gauss_map.h"
@@ -903,7 +903,8 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
   // The verification does not depend on o: any exact interior point (there is one) makes
   // the duality argument hold, so the rounded o only has to centre the virtual planes.
   if (options.incremental && !expected.empty()) {
-    if (auto built = build_verified(hs, planes, known, expected_surface(expected), options.polytope)) {
+    if (auto built =
+            build_verified(hs, planes, known, expected_surface(expected), options.polytope)) {
       built->route = HullRoute::expected;
       return std::move(*built);
     }
@@ -923,8 +924,7 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
       break;
     }
   }
-  auto built =
-      build_verified(hs, planes, known, exact_dual_hull(planes, o), options.polytope);
+  auto built = build_verified(hs, planes, known, exact_dual_hull(planes, o), options.polytope);
   if (!built) throw error("internal error: the exact dual hull of an erosion failed its own check");
   built->route = HullRoute::exact;
   return std::move(*built);
@@ -972,8 +972,9 @@ void candidate_vertices(const Polytope& B, const Location& loc, std::vector<int>
 
 /// The known points of an erosion: facet f of A passes, after moving, through v - b for
 /// each corner v of f on its plane (`on_plane`, per corner of A) and each vertex b of B
-/// attaining h_B(N_f) (contributing[f], and others[f] when there are more). Points are numbered by (v, b), or for a sum
-/// A = X (+) B by the vertex of X when b is v's own summand (v - b is then that vertex of X).
+/// attaining h_B(N_f) (contributing[f], and others[f] when there are more). Points are numbered by
+/// (v, b), or for a sum A = X (+) B by the vertex of X when b is v's own summand (v - b is then
+/// that vertex of X).
 KnownPoints erosion_points(const Polytope& A, const Polytope& B,
                            const std::vector<int>& contributing,
                            const std::vector<std::vector<int>>& others,
@@ -1048,7 +1049,8 @@ KnownPoints erosion_points(const Polytope& A, const Polytope& B,
         known.W[k] = ExactN(1);
       } else {
         const ExactN& w = A.exact_points.denominator[v];
-        known.X[k] = A.exact_points.numerator[v] - (w == 1 ? bn : V3<ExactN>{bn.x * w, bn.y * w, bn.z * w});
+        known.X[k] =
+            A.exact_points.numerator[v] - (w == 1 ? bn : V3<ExactN>{bn.x * w, bn.y * w, bn.z * w});
         known.W[k] = w;
       }
       known.Xi[k] = to_interval_n(known.X[k]);
@@ -1068,8 +1070,8 @@ MaybePolytope erode(const Polytope& A, const Polytope& B, const IntersectOptions
   const int nf = A.num_faces();
   std::vector<HalfSpace> hs(nf);
   std::vector<char> on_plane(A.corner_vertex.size(), 0);  // per corner of A
-  std::vector<int> contributing(nf);                       // the vertex of B moving f
-  std::vector<std::vector<int>> others(nf);  // more vertices of B attaining h_B(N_f)
+  std::vector<int> contributing(nf);                      // the vertex of B moving f
+  std::vector<std::vector<int>> others(nf);               // more vertices of B attaining h_B(N_f)
   parallel_chunks(nf, 64, [&](int begin, int end) {
     std::vector<Homogeneous> dots;
     std::vector<int> candidates;
@@ -1119,9 +1121,9 @@ MaybePolytope erode(const Polytope& A, const Polytope& B, const IntersectOptions
   for (const auto& p : A.points) ca = ca + p;
   for (const auto& p : B.points) cb = cb + p;
   const double ka = 1.0 / A.num_vertices(), kb = 1.0 / B.num_vertices();
-  return intersect_halfspaces(
-      hs, {ca.x * ka - cb.x * kb, ca.y * ka - cb.y * kb, ca.z * ka - cb.z * kb}, options, known,
-      expected);
+  return intersect_halfspaces(hs,
+                              {ca.x * ka - cb.x * kb, ca.y * ka - cb.y * kb, ca.z * ka - cb.z * kb},
+                              options, known, expected);
 }
 
 }  // namespace

@@ -14,8 +14,8 @@ namespace morph::detail {
 
 /// A closed half-space { x : <normal, x> <= offset / denominator }, exact. Dyadic offsets
 /// (polytopes with double or dyadic points) have denominator 1; a rational offset p/q is
-/// stored as offset p, denominator q (not necessarily reduced). `source` and `element` are carried to the facets of
-/// the result for their labels.
+/// stored as offset p, denominator q (not necessarily reduced). `source` and `element` are carried
+/// to the facets of the result for their labels.
 struct HalfSpace {
   V3<ExactN> normal;  // dyadic: a facet normal of a polytope; becomes the result facet's normal
   ExactN offset;
