@@ -295,7 +295,7 @@ TEST_CASE("halfspace_intersection: known points and an expected result give the 
 
 // A closing erodes S = A (+) B by B: the guess (A, with S's translated facets) is taken
 // when A's facets are planar, rejected for the UV sphere's nearly planar quads, and either
-// way the result is the one the hull gives.
+// way the result is the one erode_polytope's hull gives (which knows nothing of the sum).
 TEST_CASE("halfspace_intersection: a closing's expected result") {
   const auto sample = [](const std::string& name) {
     return morph::read_mesh(std::string(MORPH_SAMPLES_DIR) + "/" + name);

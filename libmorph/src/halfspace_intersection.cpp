@@ -951,6 +951,10 @@ bool same(const Homogeneous& p, const Homogeneous& q) { return compare(p, q) == 
 
 namespace {
 
+/// Whether the eroded polytope is a sum by the element (its sum_pairs name the element's
+/// vertices).
+enum class SumOfB : bool { no, yes };
+
 /// The vertices of B that may attain h_B in the direction located at `loc`: the
 /// contributing vertex, both ends of an edge, or every corner of a facet (a facet only
 /// planar within the tolerance holds some of them below its plane: checked exactly).
@@ -973,16 +977,16 @@ void candidate_vertices(const Polytope& B, const Location& loc, std::vector<int>
 /// The known points of an erosion: facet f of A passes, after moving, through v - b for
 /// each corner v of f on its plane (`on_plane`, per corner of A) and each vertex b of B
 /// attaining h_B(N_f) (contributing[f], and others[f] when there are more). Points are numbered by
-/// (v, b), or for a sum A = X (+) B by the vertex of X when b is v's own summand (v - b is then
-/// that vertex of X).
+/// (v, b), or, when A = X (+) B is a sum by this B (`sum`: A's sum_pairs), by the vertex of X
+/// when b is v's own summand (v - b is then that vertex of X).
 KnownPoints erosion_points(const Polytope& A, const Polytope& B,
                            const std::vector<int>& contributing,
                            const std::vector<std::vector<int>>& others,
-                           const std::vector<char>& on_plane) {
+                           const std::vector<char>& on_plane, SumOfB sum_of_b) {
   KnownPoints known;
   if (!B.exact_points.empty()) return known;
   const int nf = A.num_faces(), nv = A.num_vertices();
-  const bool sum = !A.sum_pairs.empty();
+  const bool sum = sum_of_b == SumOfB::yes;
   int nx = 0;
   if (sum)
     for (std::uint64_t key : A.sum_pairs) nx = std::max(nx, pair_first(key) + 1);
@@ -1065,7 +1069,7 @@ KnownPoints erosion_points(const Polytope& A, const Polytope& B,
 namespace {
 
 MaybePolytope erode(const Polytope& A, const Polytope& B, const IntersectOptions& options,
-                    const ExpectedVertices& expected) {
+                    SumOfB sum_of_b, const ExpectedVertices& expected) {
   const std::vector<Location> loc = locate_all(A, B);
   const int nf = A.num_faces();
   std::vector<HalfSpace> hs(nf);
@@ -1115,7 +1119,7 @@ MaybePolytope erode(const Polytope& A, const Polytope& B, const IntersectOptions
       h.element = B.vertex_source[b];
     }
   });
-  const KnownPoints known = erosion_points(A, B, contributing, others, on_plane);
+  const KnownPoints known = erosion_points(A, B, contributing, others, on_plane, sum_of_b);
   // A point usually inside: A's vertex centroid minus B's.
   V3<double> ca{0, 0, 0}, cb{0, 0, 0};
   for (const auto& p : A.points) ca = ca + p;
@@ -1130,7 +1134,7 @@ MaybePolytope erode(const Polytope& A, const Polytope& B, const IntersectOptions
 
 MaybePolytope erode_polytope(const Polytope& A, const Polytope& B,
                              const IntersectOptions& options) {
-  return erode(A, B, options, {});
+  return erode(A, B, options, SumOfB::no, {});
 }
 
 MaybePolytope erode_sum(const Polytope& S, const Polytope& A, const Polytope& B,
@@ -1145,7 +1149,7 @@ MaybePolytope erode_sum(const Polytope& S, const Polytope& A, const Polytope& B,
     expected.facets.reserve(A.fan_face.size());
     for (int f : A.fan_face) expected.facets.push_back(facet_of[f]);
   }
-  return erode(S, B, options, expected);
+  return erode(S, B, options, S.sum_pairs.empty() ? SumOfB::no : SumOfB::yes, expected);
 }
 
 }  // namespace morph::detail

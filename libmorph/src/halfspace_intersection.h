@@ -114,9 +114,7 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& halfspaces, con
 
 /// A (-) B = intersection over facets f of A of { x : <N_f, x> <= h_A(N_f) - h_B(N_f) }.
 /// The facets of A through a vertex v moved by a vertex b of B (one that attains h_B(N_f))
-/// all pass through v - b: these incidences are passed on as KnownPoints. When A is a sum
-/// made by sum_polytope(X, B, ...) with this B (A.sum_pairs not empty), v = X_i + B_j
-/// moved by B_j is X_i, one point for all the vertices of A over X_i (a closing).
+/// all pass through v - b: these incidences are passed on as KnownPoints.
 MaybePolytope erode_polytope(const Polytope& A, const Polytope& B,
                              const IntersectOptions& options = {});
 
@@ -124,6 +122,8 @@ MaybePolytope erode_polytope(const Polytope& A, const Polytope& B,
 /// this is A, whose facets are S's translated facets (fims.h: S's facets of A's facets
 /// come first, in A's order); that guess is checked exactly (ExpectedVertices) and the
 /// intersection is computed as any erosion when it fails (A's facets only nearly planar).
+/// A vertex A_i + B_j of S moved by B_j is A_i: one known point for all the vertices of S
+/// over A_i (S.sum_pairs).
 MaybePolytope erode_sum(const Polytope& S, const Polytope& A, const Polytope& B,
                         const IntersectOptions& options = {});
 
