@@ -7,12 +7,16 @@
 #include "halfspace_intersection.h"
 
 #include <doctest/doctest.h>
+#include <morph/io.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <string>
 #include <vector>
+
+#include "fims.h"
+#include "support/polytopes.h"
 
 namespace {
 
@@ -28,6 +32,25 @@ std::vector<HalfSpace> cube_planes(double r) {
   const double axes[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
   for (const auto& a : axes)
     hs.push_back(plane(a[0], a[1], a[2], Exact(r), static_cast<int>(hs.size())));
+  return hs;
+}
+
+/// A point that is not a double: (1/3, 1/5, 1/7).
+V3<Exact> rational_apex() {
+  return {Exact(1) / Exact(3), Exact(1) / Exact(5), Exact(1) / Exact(7)};
+}
+
+/// The cube [-2, 2]^3 and k planes tilted around the z axis, all exactly through
+/// rational_apex() (a cone's apex).
+std::vector<HalfSpace> planes_through_apex(int k) {
+  const V3<Exact> apex = rational_apex();
+  std::vector<HalfSpace> hs = cube_planes(2.0);
+  for (int i = 0; i < k; ++i) {
+    const double t = 2 * M_PI * i / k;
+    const V3<double> n{std::cos(t), std::sin(t), 0.75};
+    hs.push_back(
+        make_halfspace(to_exact_n(n), dot(to_exact(n), apex), static_cast<int>(hs.size())));
+  }
   return hs;
 }
 
@@ -129,15 +152,9 @@ TEST_CASE("halfspace_intersection: planes through one vertex are grouped exactly
 // Many planes exactly through one rational point (not a double): in doubles their dual
 // points are not coplanar, exactly they are. The apex must come out as one exact vertex.
 TEST_CASE("halfspace_intersection: many planes through a rational apex") {
-  const V3<Exact> apex{Exact(1) / Exact(3), Exact(1) / Exact(5), Exact(1) / Exact(7)};
+  const V3<Exact> apex = rational_apex();
   for (int k : {5, 12, 40}) {
-    std::vector<HalfSpace> hs = cube_planes(2.0);
-    for (int i = 0; i < k; ++i) {
-      const double t = 2 * M_PI * i / k;
-      const V3<double> n{std::cos(t), std::sin(t), 0.75};
-      hs.push_back(
-          make_halfspace(to_exact_n(n), dot(to_exact(n), apex), static_cast<int>(hs.size())));
-    }
+    const std::vector<HalfSpace> hs = planes_through_apex(k);
     const MaybePolytope r = checked(hs);
     REQUIRE(r.polytope);
     int found = 0;
@@ -206,15 +223,7 @@ TEST_CASE("halfspace_intersection: exact vertices plus doubles round as their ra
     const double got = round_quotient(X, W, Interval(estimate));
     return std::memcmp(&got, &want, sizeof got) == 0;  // also tells 0 from -0
   };
-  const V3<Exact> apex{Exact(1) / Exact(3), Exact(1) / Exact(5), Exact(1) / Exact(7)};
-  std::vector<HalfSpace> hs = cube_planes(2.0);
-  for (int i = 0; i < 12; ++i) {
-    const double t = 2 * M_PI * i / 12;
-    const V3<double> n{std::cos(t), std::sin(t), 0.75};
-    hs.push_back(
-        make_halfspace(to_exact_n(n), dot(to_exact(n), apex), static_cast<int>(hs.size())));
-  }
-  const MaybePolytope r = checked(hs);
+  const MaybePolytope r = checked(planes_through_apex(12));
   REQUIRE(r.polytope);
   const Polytope& p = *r.polytope;
   REQUIRE(!p.exact_points.empty());
@@ -241,4 +250,65 @@ TEST_CASE("halfspace_intersection: exact vertices plus doubles round as their ra
     CHECK(rounds_exactly((ExactN(x) - ExactN(half_ulp)) * ExactN(3), ExactN(3), x));
   }
   CHECK(rounds_exactly(ExactN(0.0), ExactN(7.0), 0.0));
+}
+
+// Known points (planes through one point) and an expected result only save work: the
+// intersection is the same, exactly, and a wrong guess is caught by the check.
+TEST_CASE("halfspace_intersection: known points and an expected result give the same result") {
+  const V3<Exact> apex = rational_apex();
+  std::vector<HalfSpace> hs = planes_through_apex(12);
+  const MaybePolytope plain = checked(hs);
+  REQUIRE(plain.polytope);
+  // The apex as X / W = (35, 21, 15) / 105, on the twelve tilted planes.
+  KnownPoints known;
+  known.X = {{ExactN(35), ExactN(21), ExactN(15)}};
+  known.W = {ExactN(105)};
+  {
+    RoundingGuard guard;
+    known.Xi = {{Interval(35), Interval(21), Interval(15)}};
+    known.Wi = {Interval(105)};
+  }
+  known.begin.assign(7, 0);
+  for (int i = 0; i < 12; ++i) {
+    known.point.push_back(0);
+    known.begin.push_back(static_cast<int>(known.point.size()));
+  }
+  const MaybePolytope with_known = intersect_halfspaces(hs, {0, 0, 0}, {}, known);
+  CHECK(with_known.route == HullRoute::incremental);
+  CHECK(difference(with_known, plain) == "");
+  CHECK(rounded_from_exact(with_known));
+  // The result's own fans as the guess: taken and checked; as a guess for more planes
+  // (one cuts the apex off), rejected, and the hull gives the right answer.
+  const Polytope& p = *plain.polytope;
+  ExpectedVertices expected;
+  expected.begin = p.fan_begin;
+  for (int f : p.fan_face) expected.facets.push_back(p.face_source[f]);
+  const MaybePolytope guessed = intersect_halfspaces(hs, {0, 0, 0}, {}, known, expected);
+  CHECK(guessed.route == HullRoute::expected);
+  CHECK(difference(guessed, plain) == "");
+  std::vector<HalfSpace> cut = hs;
+  cut.push_back(plane(0, 0, 1, apex.z - Exact(1) / Exact(100), static_cast<int>(cut.size())));
+  const MaybePolytope wrong = intersect_halfspaces(cut, {0, 0, 0}, {}, {}, expected);
+  CHECK(wrong.route == HullRoute::incremental);
+  CHECK(difference(wrong, checked(cut)) == "");
+}
+
+// A closing erodes S = A (+) B by B: the guess (A, with S's translated facets) is taken
+// when A's facets are planar, rejected for the UV sphere's nearly planar quads, and either
+// way the result is the one erode_polytope's hull gives (which knows nothing of the sum).
+TEST_CASE("halfspace_intersection: a closing's expected result") {
+  const auto sample = [](const std::string& name) {
+    return morph::read_mesh(std::string(MORPH_SAMPLES_DIR) + "/" + name);
+  };
+  const Polytope B = make_operand(morph::test::scaled(sample("icosphere_80.off"), 0.25), "B");
+  for (const char* name : {"icosphere_320.off", "cube.off", "uvsphere_1600.off"}) {
+    INFO(name);
+    const Polytope A = make_operand(sample(name), "A");
+    const Polytope S = sum_polytope(A, B, fims_facets(A, B));
+    const MaybePolytope closed = erode_sum(S, A, B);
+    const MaybePolytope hull = erode_polytope(S, B);
+    CHECK(difference(closed, hull) == "");
+    CHECK(rounded_from_exact(closed));
+    CHECK((closed.route == HullRoute::expected) == (std::string(name) != "uvsphere_1600.off"));
+  }
 }

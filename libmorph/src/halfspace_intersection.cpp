@@ -14,6 +14,10 @@
 // the exact route computes the dual hull on exact rational points (CGAL). Both routes end
 // in the same exact, canonical construction; vertices are rounded exactly from their
 // homogeneous coordinates, and rationals are formed only for a polytope chained further.
+// Incidences the caller knows (KnownPoints: an erosion's facets of A around a vertex moved
+// by one vertex of B) make vertices without exact constructions and zero tests free, and
+// an expected result (ExpectedVertices: a closing's A) replaces the hull when it passes
+// the check.
 #include "halfspace_intersection.h"
 
 #include <CGAL/Lazy_kernel.h>
@@ -33,7 +37,9 @@
 #include <deque>
 #include <map>
 #include <numeric>
+#include <unordered_map>
 
+#include "fims.h"
 #include "gauss_map.h"
 #include "parallel.h"
 
@@ -175,6 +181,7 @@ struct HVertex {
   bool has_exact = false;
   V3<ExactN> X;
   ExactN W;
+  int known = -1;  // the known point it is (KnownPoints), if any
 };
 
 /// The point of three planes (Cramer's rule); W = det(n_a, n_b, n_c).
@@ -195,6 +202,29 @@ HVertex vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& ab
   meet(a.ni, a.di, b.ni, b.di, c.ni, c.di, v.Xi, v.Wi);
   v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
   return v;
+}
+
+/// The vertex of three planes, taken from a known point when the three pass through one
+/// (and their normals are independent: the meet is then that point).
+HVertex vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& abc,
+                  const KnownPoints& known) {
+  HVertex v = vertex_of(planes, abc);
+  if (known.empty() || !(v.Wi.inf() > 0)) return v;
+  const int k = known.common(abc[0], abc[1], abc[2]);
+  if (k < 0) return v;
+  v.known = k;
+  v.Xi = known.Xi[k];
+  v.Wi = known.Wi[k];
+  v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
+  v.X = known.X[k];
+  v.W = known.W[k];
+  v.has_exact = true;
+  return v;
+}
+
+/// Whether plane i is known to pass through vertex v (no arithmetic).
+bool known_through(const KnownPoints& known, int i, const HVertex& v) {
+  return v.known >= 0 && known.passes(i, v.known);
 }
 
 /// Computes the exact coordinates of a vertex, once.
@@ -306,7 +336,8 @@ bool clockwise(const std::vector<int>& cyc, const std::vector<HVertex>& vertex,
 /// dual hull of all the planes; nullopt when it is not. The result has `rounded`, and
 /// `polytope` when `with_polytope`.
 std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
-                                            const std::vector<Plane>& planes, const DualSurface& s,
+                                            const std::vector<Plane>& planes,
+                                            const KnownPoints& known, const DualSurface& s,
                                             bool with_polytope) {
   const int nt = static_cast<int>(s.corner.size());
   const int n = static_cast<int>(planes.size());
@@ -361,7 +392,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       if (group[t0] >= 0) continue;
       const int g = static_cast<int>(seed.size());
       seed.push_back(t0);
-      vertex.push_back(vertex_of(planes, s.corner[t0]));
+      vertex.push_back(vertex_of(planes, s.corner[t0], known));
       through.assign(s.corner[t0].begin(), s.corner[t0].end());
       group[t0] = g;
       stack.assign(1, t0);
@@ -376,11 +407,13 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
           for (int j = 0; j < 3; ++j)
             if (cn[j] != a && cn[j] != b) far = cn[j];
           if (far < 0) return std::nullopt;
-          const bool known = std::find(through.begin(), through.end(), far) != through.end();
-          const int sd = known ? 0 : side(planes, planes[far], vertex[g]);
+          const bool seen = std::find(through.begin(), through.end(), far) != through.end();
+          const int sd = seen || known_through(known, far, vertex[g])
+                             ? 0
+                             : side(planes, planes[far], vertex[g]);
           if (sd > 0) return std::nullopt;
           if (sd < 0) continue;
-          if (!known) through.push_back(far);
+          if (!seen) through.push_back(far);
           if (group[nb] < 0) {
             group[nb] = g;
             stack.push_back(nb);
@@ -456,7 +489,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
           }
         }
       }
-      const int sd = side(p, vertex[u]);
+      const int sd = known_through(known, others[j], vertex[u]) ? 0 : side(p, vertex[u]);
       if (sd > 0) ok = false;
       if (sd != 0) continue;
       std::vector<int>& plateau = touched[j];
@@ -464,7 +497,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       for (std::size_t q = 0; q < plateau.size(); ++q)
         for (int a = adj_begin[plateau[q]]; a < adj_begin[plateau[q] + 1]; ++a)
           if (std::find(plateau.begin(), plateau.end(), adj[a]) == plateau.end() &&
-              side(p, vertex[adj[a]]) == 0)
+              (known_through(known, others[j], vertex[adj[a]]) || side(p, vertex[adj[a]]) == 0))
             plateau.push_back(adj[a]);
       std::sort(plateau.begin(), plateau.end());
     }
@@ -567,8 +600,9 @@ class IncrementalHull {
  public:
   enum class Outcome { hull, too_small, failed };
 
-  IncrementalHull(const std::vector<Plane>& planes, const V3<double>& o, double reach)
-      : planes_(planes), n_(static_cast<int>(planes.size())) {
+  IncrementalHull(const std::vector<Plane>& planes, const KnownPoints& known, const V3<double>& o,
+                  double reach)
+      : planes_(planes), known_(known), n_(static_cast<int>(planes.size())) {
     const double dirs[4][3] = {{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}};
     for (int k = 0; k < 4; ++k) {
       const V3<ExactN> m{ExactN(dirs[k][0]), ExactN(dirs[k][1]), ExactN(dirs[k][2])};
@@ -611,6 +645,7 @@ class IncrementalHull {
     V3<Interval> Xi;               // the vertex of the three planes, X / W
     Interval Wi;
     int exact = -1;    // its exact coordinates in exact_, once computed
+    int known = -1;    // the known point it is, if any (KnownPoints)
     int pending = -1;  // first of the planes that see it (linked by next_pending_)
     bool alive = true;
   };
@@ -627,6 +662,9 @@ class IncrementalHull {
     t.across = {-1, -1, -1};
     const Plane &pa = plane(a), &pb = plane(b), &pc = plane(c);
     meet(pa.ni, pa.di, pb.ni, pb.di, pc.ni, pc.di, t.Xi, t.Wi);
+    // Three planes through a known point with independent normals (W > 0) meet there.
+    if (!known_.empty() && a < n_ && b < n_ && c < n_ && t.Wi.inf() > 0)
+      t.known = known_.common(a, b, c);
     tris_.push_back(t);
     return static_cast<int>(tris_.size()) - 1;
   }
@@ -634,6 +672,12 @@ class IncrementalHull {
   int side_of(int p, int t) {
     Tri& tri = tris_[t];
     const Plane& h = plane(p);
+    if (tri.known >= 0) {  // the same sign as on the meet (a positive multiple)
+      const int k = tri.known;
+      if (p < n_ && known_.passes(p, k)) return 0;
+      const int s = interval_sign(dot(h.ni, known_.Xi[k]) - h.di * known_.Wi[k]);
+      return s != 2 ? s : CGAL::sign(dot(h.n, known_.X[k]) - h.d * known_.W[k]);
+    }
     const int s = interval_sign(dot(h.ni, tri.Xi) - h.di * tri.Wi);
     if (s != 2) return s;
     if (tri.exact < 0) {
@@ -744,6 +788,7 @@ class IncrementalHull {
   }
 
   const std::vector<Plane>& planes_;
+  const KnownPoints& known_;
   int n_;
   std::array<Plane, 4> virtual_;
   std::vector<Tri> tris_;
@@ -797,8 +842,43 @@ HalfSpace make_halfspace(const V3<ExactN>& normal, const Exact& offset, int sour
   return {normal, integer_n(offset.numerator()), integer_n(offset.denominator()), source};
 }
 
+/// The dual surface of an expected result: each vertex's facets fanned into triangles
+/// (counter-clockwise seen from outside, as the dual hull's), joined across shared edges.
+/// Empty when the fans do not close up into a surface.
+DualSurface expected_surface(const ExpectedVertices& expected) {
+  DualSurface s;
+  const int nv = static_cast<int>(expected.begin.size()) - 1;
+  for (int v = 0; v < nv; ++v) {
+    const int* f = &expected.facets[expected.begin[v]];
+    const int k = expected.begin[v + 1] - expected.begin[v];
+    if (k < 3) return {};
+    for (int i = 1; i + 1 < k; ++i) s.corner.push_back({f[0], f[i], f[i + 1]});
+  }
+  const int nt = static_cast<int>(s.corner.size());
+  std::unordered_map<std::uint64_t, int> edge_of;  // directed edge (a, b) -> 3 t + k
+  edge_of.reserve(3 * static_cast<std::size_t>(nt));
+  const auto key = [](int a, int b) {
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
+           static_cast<std::uint32_t>(b);
+  };
+  for (int t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k)
+      if (!edge_of.emplace(key(s.corner[t][k], s.corner[t][(k + 1) % 3]), 3 * t + k).second)
+        return {};
+  s.across.resize(nt);
+  for (int t = 0; t < nt; ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const auto it = edge_of.find(key(s.corner[t][(k + 1) % 3], s.corner[t][k]));
+      if (it == edge_of.end()) return {};
+      s.across[t][k] = it->second / 3;
+    }
+  }
+  return s;
+}
+
 MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<double>& hint,
-                                   const IntersectOptions& options) {
+                                   const IntersectOptions& options, const KnownPoints& known,
+                                   const ExpectedVertices& expected) {
   MaybePolytope out;
   const std::vector<Plane> planes = planes_of(hs);
   V3<Exact> o = to_exact(hint);
@@ -822,14 +902,21 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
   }
   // The verification does not depend on o: any exact interior point (there is one) makes
   // the duality argument hold, so the rounded o only has to centre the virtual planes.
+  if (options.incremental && !expected.empty()) {
+    if (auto built =
+            build_verified(hs, planes, known, expected_surface(expected), options.polytope)) {
+      built->route = HullRoute::expected;
+      return std::move(*built);
+    }
+  }
   if (options.incremental) {
     double reach = first_reach(planes, o_double);
     for (int attempt = 0; attempt < kReachAttempts; ++attempt, reach = std::ldexp(reach, 20)) {
       DualSurface s;
-      const auto outcome = IncrementalHull(planes, o_double, reach).run(s);
+      const auto outcome = IncrementalHull(planes, known, o_double, reach).run(s);
       if (outcome == IncrementalHull::Outcome::too_small) continue;
       if (outcome == IncrementalHull::Outcome::hull) {
-        if (auto built = build_verified(hs, planes, s, options.polytope)) {
+        if (auto built = build_verified(hs, planes, known, s, options.polytope)) {
           built->route = HullRoute::incremental;
           return std::move(*built);
         }
@@ -837,48 +924,239 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
       break;
     }
   }
-  auto built = build_verified(hs, planes, exact_dual_hull(planes, o), options.polytope);
+  auto built = build_verified(hs, planes, known, exact_dual_hull(planes, o), options.polytope);
   if (!built) throw error("internal error: the exact dual hull of an erosion failed its own check");
   built->route = HullRoute::exact;
   return std::move(*built);
 }
 
-MaybePolytope erode_polytope(const Polytope& A, const Polytope& B,
-                             const IntersectOptions& options) {
+namespace {
+
+/// <n, p> for a vertex p = X / W of a polytope, as value / weight (weight > 0).
+struct Homogeneous {
+  ExactN value, weight;
+};
+Homogeneous homogeneous_dot(const Polytope& P, const V3<ExactN>& n, int v) {
+  if (P.exact_points.empty()) return {dot(n, to_exact_n(P.points[v])), ExactN(1)};
+  return {dot(n, P.exact_points.numerator[v]), P.exact_points.denominator[v]};
+}
+/// The Newell normal of triangle f of a polytope with double points.
+V3<ExactN> triangle_normal(const Polytope& A, int f) {
+  const V3<ExactN> p = to_exact_n(A.points[A.corner(f, 0)]);
+  return cross(to_exact_n(A.points[A.corner(f, 1)]) - p, to_exact_n(A.points[A.corner(f, 2)]) - p);
+}
+/// Sign of p - q, by cross-multiplication unless both weights are 1.
+int compare(const Homogeneous& p, const Homogeneous& q) {
+  if (p.weight == 1 && q.weight == 1) return CGAL::compare(p.value, q.value);
+  return CGAL::compare(p.value * q.weight, q.value * p.weight);
+}
+bool same(const Homogeneous& p, const Homogeneous& q) { return compare(p, q) == 0; }
+
+}  // namespace
+
+namespace {
+
+/// Whether the eroded polytope is a sum by the element (its sum_pairs name the element's
+/// vertices).
+enum class SumOfB : bool { no, yes };
+
+/// The vertices of B that may attain h_B in the direction located at `loc`: the
+/// contributing vertex, both ends of an edge, or every corner of a facet (a facet only
+/// planar within the tolerance holds some of them below its plane: checked exactly).
+void candidate_vertices(const Polytope& B, const Location& loc, std::vector<int>& out) {
+  out.clear();
+  switch (loc.kind) {
+    case Location::Kind::vertex:
+      out.push_back(loc.index);
+      break;
+    case Location::Kind::edge:
+      out.push_back(B.edges[loc.index].from);
+      out.push_back(B.edges[loc.index].to);
+      break;
+    case Location::Kind::face:
+      for (int k = 0; k < B.degree(loc.index); ++k) out.push_back(B.corner(loc.index, k));
+      break;
+  }
+}
+
+/// The known points of an erosion: facet f of A passes, after moving, through v - b for
+/// each corner v of f on its plane (`on_plane`, per corner of A) and each vertex b of B
+/// attaining h_B(N_f) (contributing[f], and others[f] when there are more). Points are numbered by
+/// (v, b), or, when A = X (+) B is a sum by this B (`sum`: A's sum_pairs), by the vertex of X
+/// when b is v's own summand (v - b is then that vertex of X).
+KnownPoints erosion_points(const Polytope& A, const Polytope& B,
+                           const std::vector<int>& contributing,
+                           const std::vector<std::vector<int>>& others,
+                           const std::vector<char>& on_plane, SumOfB sum_of_b) {
+  KnownPoints known;
+  if (!B.exact_points.empty()) return known;
+  const int nf = A.num_faces(), nv = A.num_vertices();
+  const bool sum = sum_of_b == SumOfB::yes;
+  int nx = 0;
+  if (sum)
+    for (std::uint64_t key : A.sum_pairs) nx = std::max(nx, pair_first(key) + 1);
+  // Lists of (b, point) per vertex of A and, for a sum, per vertex of X.
+  struct Node {
+    int b, point, next;
+  };
+  std::vector<Node> nodes;
+  std::vector<int> head(nv, -1), head_x(nx, -1);
+  std::vector<std::pair<int, int>> creator;  // (v, b) that first named each point
+  known.begin.assign(nf + 1, 0);
+  for (int f = 0; f < nf; ++f) {
+    for (int k = 0; k < A.degree(f); ++k) {
+      if (!on_plane[A.face_begin[f] + k]) continue;
+      const int v = A.corner(f, k);
+      const std::uint64_t pair = sum ? A.sum_pairs[A.vertex_source[v]] : 0;
+      for (int i = -1; i < static_cast<int>(others[f].size()); ++i) {
+        const int b = i < 0 ? contributing[f] : others[f][i];
+        const bool own = sum && pair_second(pair) == b;
+        int& first = own ? head_x[pair_first(pair)] : head[v];
+        int point = -1;
+        for (int q = first; q >= 0 && point < 0; q = nodes[q].next)
+          if (own || nodes[q].b == b) point = nodes[q].point;
+        if (point < 0) {
+          point = static_cast<int>(creator.size());
+          creator.emplace_back(v, b);
+          nodes.push_back({b, point, first});
+          first = static_cast<int>(nodes.size()) - 1;
+        }
+        known.point.push_back(point);
+      }
+    }
+    known.begin[f + 1] = static_cast<int>(known.point.size());
+  }
+  // Only a point on three planes or more can be a vertex: the others are dropped.
+  std::vector<int> count(creator.size(), 0);
+  for (int k : known.point) ++count[k];
+  std::vector<int> renumber(creator.size(), -1);
+  int np = 0;
+  for (std::size_t k = 0; k < creator.size(); ++k)
+    if (count[k] >= 3) {
+      renumber[k] = np;
+      creator[np++] = creator[k];
+    }
+  creator.resize(np);
+  int kept = 0;
+  for (int f = 0, j = 0; f < nf; ++f) {
+    for (; j < known.begin[f + 1]; ++j)
+      if (renumber[known.point[j]] >= 0) known.point[kept++] = renumber[known.point[j]];
+    known.begin[f + 1] = kept;
+  }
+  known.point.resize(kept);
+  known.X.resize(np);
+  known.W.resize(np);
+  known.Xi.resize(np);
+  known.Wi.resize(np);
+  parallel_chunks(np, 512, [&](int begin, int end) {
+    RoundingGuard guard;
+    for (int k = begin; k < end; ++k) {
+      const auto [v, b] = creator[k];
+      const V3<ExactN> bn = to_exact_n(B.points[b]);
+      if (A.exact_points.empty()) {
+        known.X[k] = to_exact_n(A.points[v]) - bn;
+        known.W[k] = ExactN(1);
+      } else {
+        const ExactN& w = A.exact_points.denominator[v];
+        known.X[k] =
+            A.exact_points.numerator[v] - (w == 1 ? bn : V3<ExactN>{bn.x * w, bn.y * w, bn.z * w});
+        known.W[k] = w;
+      }
+      known.Xi[k] = to_interval_n(known.X[k]);
+      known.Wi[k] = to_interval_n(known.W[k]);
+    }
+  });
+  return known;
+}
+
+}  // namespace
+
+namespace {
+
+MaybePolytope erode(const Polytope& A, const Polytope& B, const IntersectOptions& options,
+                    SumOfB sum_of_b, const ExpectedVertices& expected) {
   const std::vector<Location> loc = locate_all(A, B);
   const int nf = A.num_faces();
   std::vector<HalfSpace> hs(nf);
-  const bool dyadic = A.exact_points.empty() && B.exact_points.empty();
+  std::vector<char> on_plane(A.corner_vertex.size(), 0);  // per corner of A
+  std::vector<int> contributing(nf);                      // the vertex of B moving f
+  std::vector<std::vector<int>> others(nf);               // more vertices of B attaining h_B(N_f)
   parallel_chunks(nf, 64, [&](int begin, int end) {
+    std::vector<Homogeneous> dots;
+    std::vector<int> candidates;
     for (int f = begin; f < end; ++f) {
-      const V3<ExactN>& n = A.exact_normal(f);
+      // A triangle's Newell normal is (q - p) x (r - p), the same value in fewer products.
+      const V3<ExactN> n =
+          A.degree(f) == 3 && A.given_normals.empty() ? triangle_normal(A, f) : A.exact_normal(f);
       const int b = location_vertex(B, loc[f]);
-      if (dyadic) {
-        // Double points: every product is exact in Mpzf, no rationals needed.
-        // A triangle holds its corners exactly on the plane of its Newell normal.
-        const int corners = A.degree(f) == 3 && A.given_normals.empty() ? 1 : A.degree(f);
-        ExactN offset = dot(n, to_exact_n(A.points[A.corner(f, 0)]));
-        for (int k = 1; k < corners; ++k)
-          offset = std::max(offset, dot(n, to_exact_n(A.points[A.corner(f, k)])));
-        hs[f] = {n, offset - dot(n, to_exact_n(B.points[b])), ExactN(1), A.face_source[f],
-                 B.vertex_source[b]};
+      // h_A(N_f) = max over f's corners of <n, X> / W, compared by cross-multiplication
+      // (W > 0; W = 1 for double points, and for the exact sums of a closing): no
+      // rationals, no gcd. A triangle of double points holds its corners exactly on the
+      // plane of its Newell normal.
+      char* on = &on_plane[A.face_begin[f]];
+      int best = 0;
+      if (A.degree(f) == 3 && A.given_normals.empty()) {
+        dots.assign(1, homogeneous_dot(A, n, A.corner(f, 0)));
+        on[0] = on[1] = on[2] = 1;
       } else {
-        const V3<Exact> nr = to_rational(n);
-        Exact offset = dot(nr, A.exact_point(A.corner(f, 0)));
-        for (int k = 1; k < A.degree(f); ++k)
-          offset = std::max(offset, dot(nr, A.exact_point(A.corner(f, k))));
-        hs[f] = make_halfspace(n, offset - dot(nr, B.exact_point(b)), A.face_source[f]);
-        hs[f].element = B.vertex_source[b];
+        dots.clear();
+        for (int k = 0; k < A.degree(f); ++k) {
+          dots.push_back(homogeneous_dot(A, n, A.corner(f, k)));
+          if (compare(dots[k], dots[best]) > 0) best = k;
+        }
+        for (int k = 0; k < A.degree(f); ++k) on[k] = same(dots[k], dots[best]);
       }
+      const Homogeneous& top = dots[best];
+      // h_A - h_B = (p V - q W) / (W V) for h_A = p / W, h_B = q / V.
+      const Homogeneous hb = homogeneous_dot(B, n, b);
+      contributing[f] = b;
+      candidate_vertices(B, loc[f], candidates);
+      for (int c : candidates) {
+        if (c != b && same(homogeneous_dot(B, n, c), hb)) others[f].push_back(c);
+      }
+      HalfSpace& h = hs[f];
+      h.normal = n;
+      if (top.weight == 1 && hb.weight == 1) {
+        h.offset = top.value - hb.value;
+      } else {
+        h.offset = top.value * hb.weight - hb.value * top.weight;
+        h.denominator = top.weight * hb.weight;
+      }
+      h.source = A.face_source[f];
+      h.element = B.vertex_source[b];
     }
   });
+  const KnownPoints known = erosion_points(A, B, contributing, others, on_plane, sum_of_b);
   // A point usually inside: A's vertex centroid minus B's.
   V3<double> ca{0, 0, 0}, cb{0, 0, 0};
   for (const auto& p : A.points) ca = ca + p;
   for (const auto& p : B.points) cb = cb + p;
   const double ka = 1.0 / A.num_vertices(), kb = 1.0 / B.num_vertices();
-  return intersect_halfspaces(
-      hs, {ca.x * ka - cb.x * kb, ca.y * ka - cb.y * kb, ca.z * ka - cb.z * kb}, options);
+  return intersect_halfspaces(hs,
+                              {ca.x * ka - cb.x * kb, ca.y * ka - cb.y * kb, ca.z * ka - cb.z * kb},
+                              options, known, expected);
+}
+
+}  // namespace
+
+MaybePolytope erode_polytope(const Polytope& A, const Polytope& B,
+                             const IntersectOptions& options) {
+  return erode(A, B, options, SumOfB::no, {});
+}
+
+MaybePolytope erode_sum(const Polytope& S, const Polytope& A, const Polytope& B,
+                        const IntersectOptions& options) {
+  // S's facet of each facet f of A: the one made from SumFacets facet f (translated).
+  std::vector<int> facet_of(A.num_faces(), -1);
+  for (int g = 0; g < S.num_faces(); ++g)
+    if (S.face_source[g] < A.num_faces()) facet_of[S.face_source[g]] = g;
+  ExpectedVertices expected;
+  if (std::find(facet_of.begin(), facet_of.end(), -1) == facet_of.end()) {
+    expected.begin = A.fan_begin;
+    expected.facets.reserve(A.fan_face.size());
+    for (int f : A.fan_face) expected.facets.push_back(facet_of[f]);
+  }
+  return erode(S, B, options, S.sum_pairs.empty() ? SumOfB::no : SumOfB::yes, expected);
 }
 
 }  // namespace morph::detail

@@ -14,8 +14,8 @@ namespace morph::detail {
 
 /// A closed half-space { x : <normal, x> <= offset / denominator }, exact. Dyadic offsets
 /// (polytopes with double or dyadic points) have denominator 1; a rational offset p/q is
-/// stored as offset p, denominator q. `source` and `element` are carried to the facets of
-/// the result for their labels.
+/// stored as offset p, denominator q (not necessarily reduced). `source` and `element` are carried
+/// to the facets of the result for their labels.
 struct HalfSpace {
   V3<ExactN> normal;  // dyadic: a facet normal of a polytope; becomes the result facet's normal
   ExactN offset;
@@ -32,6 +32,7 @@ enum class HullRoute : unsigned char {
   none,         // empty or flat: no hull
   incremental,  // the exact incremental hull on the planes, checked exactly
   exact,        // CGAL's hull of the exact dual points (its check failed, or it was not tried)
+  expected,     // the caller's expected result (ExpectedVertices), checked exactly
 };
 
 /// An intersection as it is written out: its vertices rounded to nearest (from their exact
@@ -60,17 +61,70 @@ struct IntersectOptions {
   bool polytope = true;     // false: only `rounded` (a final result: no rationals, no Polytope)
 };
 
+/// Points known to lie exactly on some of the half-spaces' planes: an erosion knows them
+/// combinatorially (the facets of A around a vertex v moved by the same vertex b of B all
+/// pass through v - b). Point k is X[k] / W[k] (W[k] > 0, enclosed by Xi[k] / Wi[k]); the
+/// plane of half-space i passes through points point[begin[i]] .. point[begin[i + 1] - 1].
+/// A vertex of the intersection whose three planes share a known point is that point (no
+/// exact construction), and a plane through it tests zero without arithmetic. Empty: none.
+struct KnownPoints {
+  std::vector<V3<ExactN>> X;
+  std::vector<ExactN> W;
+  std::vector<V3<Interval>> Xi;
+  std::vector<Interval> Wi;
+  std::vector<int> begin;  // size n + 1 for n half-spaces, or empty
+  std::vector<int> point;
+  bool empty() const { return begin.empty(); }
+  /// Whether half-space i's plane is known to pass through point k.
+  bool passes(int i, int k) const {
+    for (int j = begin[i]; j < begin[i + 1]; ++j)
+      if (point[j] == k) return true;
+    return false;
+  }
+  /// A point known to lie on the planes of half-spaces a, b and c, or -1.
+  int common(int a, int b, int c) const {
+    for (int j = begin[a]; j < begin[a + 1]; ++j)
+      if (passes(b, point[j]) && passes(c, point[j])) return point[j];
+    return -1;
+  }
+};
+
+/// What the intersection is expected to be, when the caller knows (a closing gives A
+/// back): for each expected vertex, the half-spaces of the facets around it,
+/// counter-clockwise seen from outside (facets[begin[v]] ..). Only a guess: it is checked
+/// exactly, as any candidate, and the hull is computed when the check fails. Empty: none.
+struct ExpectedVertices {
+  std::vector<int> begin;  // size V + 1, or empty
+  std::vector<int> facets;
+  bool empty() const { return begin.empty(); }
+};
+
 /// The intersection of bounded half-spaces (their normals must positively span space).
 /// `hint` is a point that is often strictly inside (checked exactly; an exact linear
 /// program finds one otherwise). Empty or flat intersections are reported, not thrown.
 /// The result is exact and canonical (numbered by the half-spaces through each vertex),
 /// whichever route computed it. Expected O(n log n) for n half-spaces (exact arithmetic
 /// only where interval filters cannot decide).
+/// `known`: points known to lie on the planes; `expected`: a guess of the result (both
+/// optional: the result is the same, only faster).
 MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& halfspaces, const V3<double>& hint,
-                                   const IntersectOptions& options = {});
+                                   const IntersectOptions& options = {},
+                                   const KnownPoints& known = {},
+                                   const ExpectedVertices& expected = {});
 
 /// A (-) B = intersection over facets f of A of { x : <N_f, x> <= h_A(N_f) - h_B(N_f) }.
+/// The facets of A through a vertex v moved by a vertex b of B (one that attains h_B(N_f))
+/// all pass through v - b: these incidences are passed on as KnownPoints.
 MaybePolytope erode_polytope(const Polytope& A, const Polytope& B,
                              const IntersectOptions& options = {});
+
+/// (A (+) B) (-) B for S = sum_polytope(A, B, fims_facets(A, B)): a closing. For convex A
+/// this is A, whose facets are S's translated facets (fims.h: S's facets of A's facets
+/// come first, in A's order); that guess is checked exactly (ExpectedVertices) and the
+/// intersection is computed as any erosion when it fails (A's facets only nearly planar).
+/// A vertex A_i + B_j of S moved by B_j is A_i: one known point for all the vertices of S
+/// over A_i (S.sum_pairs).
+MaybePolytope erode_sum(const Polytope& S, const Polytope& A, const Polytope& B,
+                        const IntersectOptions& options = {});
 
 }  // namespace morph::detail

@@ -402,7 +402,10 @@ Polytope sum_polytope(const Polytope& A, const Polytope& B, const SumFacets& fac
         static_cast<int>(cycle.size()),
         [&](int i) -> const V3<ExactN>& { return exact.numerator[cycle[i]]; });
   }
-  return make_polytope(std::move(points), std::move(exact), faces, std::move(normals), "A (+) B");
+  Polytope p =
+      make_polytope(std::move(points), std::move(exact), faces, std::move(normals), "A (+) B");
+  p.sum_pairs = std::move(pairs);  // vertex_source indexes them
+  return p;
 }
 
 }  // namespace morph::detail

@@ -20,6 +20,7 @@
 #include <morph/mesh.h>
 
 #include <atomic>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -94,6 +95,10 @@ struct Polytope {
   // The facet normals as unit double vectors with error bounds: the fast filter of every
   // predicate on normals (see orient_normals).
   std::vector<UnitNormal> unit_normals;
+
+  // A sum made by sum_polytope(X, Y, ...): vertex v is X's vertex pair_first(sum_pairs[
+  // vertex_source[v]]) plus Y's pair_second(...) (pair_key, fims.h). Empty otherwise.
+  std::vector<std::uint64_t> sum_pairs;
 
   // Where each element came from in the operand mesh (labels): a representative face,
   // the vertex, a representative edge. -1 when not from a mesh.
