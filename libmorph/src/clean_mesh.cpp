@@ -10,7 +10,7 @@
 //      three groups around them (inside a merged facet or in the middle of an edge) go.
 // When the facets no longer describe a closed manifold after pass 1 or a merged polygon
 // is not convex to within the feature size, the mesh is rebuilt instead from the convex
-// hull of the points (exact predicates), whose triangles go through passes 2 and 3.
+// hull of the points (exact predicates), whose exact facets go through passes 2 and 3.
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/convex_hull_3.h>
@@ -302,7 +302,7 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
 }
 
 /// Passes 2 and 3, then connectivity of the result. Strict: nothing when the soup is not
-/// a closed manifold or merging fails; else (hull triangles) an unmerged soup is kept.
+/// a closed manifold or merging fails; else (hull facets) an unmerged soup is kept.
 /// `soup` is moved into the result when it is the result, and left alone otherwise.
 std::optional<std::pair<Soup, Connectivity>> simplify(const std::vector<V3<double>>& points,
                                                       Soup& soup, double limit, bool strict) {
@@ -369,10 +369,15 @@ Mesh build(const std::vector<V3<double>>& points, const Soup& soup, const Connec
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using HullMesh = CGAL::Surface_mesh<Kernel::Point_3>;
 
-/// The triangles of the convex hull of the cluster points (exact predicates on the
-/// doubles), each with the result facet it belongs to: among the facets its corners came
-/// from (those shared by all three when there are any), the one whose normal is closest.
-Soup hull_triangles(const std::vector<V3<double>>& points, const Soup& facets) {
+/// The facets of the convex hull of the cluster points (exact predicates on the doubles),
+/// each with the result facet it belongs to: among the facets its corners came from (those
+/// shared by all its corners when there are any), the one whose normal is closest.
+/// CGAL's hull is triangulated, and how it splits a flat facet depends on the order of its
+/// internal pointers, which varies from run to run (and with threads); so its triangles are
+/// grouped where they are exactly coplanar (orientation predicate), and each group becomes
+/// its boundary polygon, starting at its lowest point; polygons are sorted. The result
+/// does not depend on the triangulation.
+Soup hull_facets(const std::vector<V3<double>>& points, const Soup& facets) {
   const int nf = facets.size();
   std::map<int, std::vector<int>> facets_of;  // point -> facets that have it as a corner
   for (int f = 0; f < nf; ++f)
@@ -399,39 +404,74 @@ Soup hull_triangles(const std::vector<V3<double>>& points, const Soup& facets) {
     const double len = std::sqrt(dot(sum, sum));
     facet_normal[f] = len > 0 ? V3<double>{sum.x / len, sum.y / len, sum.z / len} : sum;
   }
-  // CGAL's hull keys internal maps by pointer, so its face order is not reproducible:
-  // triangles are ordered by their point indices, each starting at its lowest.
-  std::vector<std::array<int, 4>> tris;  // three points, source
-  for (auto t : hull.faces()) {
-    std::vector<int> tri;
-    for (auto v : CGAL::vertices_around_face(hull.halfedge(t), hull))
-      tri.push_back(point_of.at(hull.point(v)));
-    std::rotate(tri.begin(), std::min_element(tri.begin(), tri.end()), tri.end());
-    std::vector<int> common = facets_of.at(tri[0]), all = common;
-    for (int k = 1; k < 3; ++k) {
-      const auto& fs = facets_of.at(tri[k]);
+  // Groups of exactly coplanar triangles (union-find over the hull's faces).
+  using Face = HullMesh::Face_index;
+  std::vector<int> parent(hull.number_of_faces());
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  const auto point_at = [&](HullMesh::Halfedge_index h) { return hull.point(hull.target(h)); };
+  for (auto e : hull.edges()) {
+    const auto h = hull.halfedge(e), o = hull.opposite(h);
+    const int a = find(static_cast<int>(Face(hull.face(h)))),
+              b = find(static_cast<int>(Face(hull.face(o))));
+    if (a == b) continue;
+    if (CGAL::coplanar(point_at(h), point_at(o), point_at(hull.next(h)), point_at(hull.next(o))))
+      parent[std::max(a, b)] = std::min(a, b);
+  }
+  // Each group's boundary: one outgoing boundary edge per corner (a flat part of a convex
+  // surface is a convex polygon), chained from the lowest point.
+  std::map<int, std::map<int, int>> boundary;  // group -> (from point -> to point)
+  for (auto h : hull.halfedges()) {
+    const int g = find(static_cast<int>(Face(hull.face(h))));
+    if (g == find(static_cast<int>(Face(hull.face(hull.opposite(h)))))) continue;
+    const int from = point_of.at(hull.point(hull.source(h)));
+    if (!boundary[g].emplace(from, point_of.at(point_at(h))).second)
+      throw error("internal error: a flat part of a hull is not a polygon");
+  }
+  std::vector<std::pair<std::vector<int>, int>> polygons;  // points, source
+  for (const auto& [g, next] : boundary) {
+    std::vector<int> cycle;
+    int v = next.begin()->first;  // the lowest point
+    do {
+      cycle.push_back(v);
+      const auto it = next.find(v);
+      if (it == next.end() || cycle.size() > next.size())
+        throw error("internal error: a flat part of a hull is not a polygon");
+      v = it->second;
+    } while (v != cycle.front());
+    if (cycle.size() != next.size())
+      throw error("internal error: a flat part of a hull is not a polygon");
+    std::vector<int> common = facets_of.at(cycle[0]), all = common;
+    V3<double> normal{0, 0, 0};  // Newell's, about the first corner
+    for (std::size_t k = 1; k < cycle.size(); ++k) {
+      const auto& fs = facets_of.at(cycle[k]);
       std::vector<int> both;
       std::set_intersection(common.begin(), common.end(), fs.begin(), fs.end(),
                             std::back_inserter(both));
       common = std::move(both);
       all.insert(all.end(), fs.begin(), fs.end());
+      if (k + 1 < cycle.size())
+        normal = normal + cross(points[cycle[k]] - points[cycle[0]],
+                                points[cycle[k + 1]] - points[cycle[0]]);
     }
     const std::vector<int>& candidates = common.empty() ? all : common;
-    const V3<double> tn = cross(points[tri[1]] - points[tri[0]], points[tri[2]] - points[tri[0]]);
     int best = -1;
-    double best_dot = -2;
+    double best_dot = -std::numeric_limits<double>::infinity();
     for (int f : candidates) {
-      const double d = dot(tn, facet_normal[f]);
+      const double d = dot(normal, facet_normal[f]);
       if (d > best_dot || (d == best_dot && f < best)) {
         best_dot = d;
         best = f;
       }
     }
-    tris.push_back({tri[0], tri[1], tri[2], best >= 0 ? facets.source[best] : -1});
+    polygons.emplace_back(std::move(cycle), best >= 0 ? facets.source[best] : -1);
   }
-  std::sort(tris.begin(), tris.end());
+  std::sort(polygons.begin(), polygons.end());
   Soup out;
-  for (const auto& t : tris) out.add({t[0], t[1], t[2]}, t[3]);
+  for (const auto& [cycle, source] : polygons) out.add(cycle, source);
   return out;
 }
 
@@ -503,7 +543,7 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
   std::optional<std::pair<Soup, Connectivity>> result;
   if (!repeated) result = simplify(points, soup, limit, true);
   if (!result) {
-    Soup hull = hull_triangles(points, soup);
+    Soup hull = hull_facets(points, soup);
     result = simplify(points, hull, limit, false);
   }
   if (!result) throw error("internal error: the hull of a result could not be joined into a mesh");
