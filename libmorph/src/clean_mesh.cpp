@@ -118,13 +118,14 @@ FacetGeometry geometry(const std::vector<V3<double>>& points, const Soup& soup, 
   const V3<double>& origin = points[soup.vertex[b]];
   V3<double> sum{0, 0, 0}, centroid{0, 0, 0};
   double longest_squared = 0;  // the root is monotonic: the root of the maximum is the maximum root
+  V3<double> p{0, 0, 0};  // the corner's offset from the origin (each computed once)
   for (int k = 0; k < d; ++k) {
-    const V3<double> p = points[soup.vertex[b + k]] - origin;
-    const V3<double> q = points[soup.vertex[b + (k + 1 == d ? 0 : k + 1)]] - origin;
+    const V3<double> q = k + 1 == d ? V3<double>{0, 0, 0} : points[soup.vertex[b + k + 1]] - origin;
     sum = sum + cross(p, q);  // Newell's normal (twice the vector area)
     const V3<double> e = q - p;
     longest_squared = std::max(longest_squared, dot(e, e));
     centroid = centroid + p;
+    p = q;
   }
   g.longest_edge = std::sqrt(longest_squared);
   centroid = {origin.x + centroid.x / d, origin.y + centroid.y / d, origin.z + centroid.z / d};
@@ -141,7 +142,8 @@ bool is_thin(const FacetGeometry& g, double limit) {
 }
 
 struct Groups {
-  std::vector<int> of;  // group (its lowest facet index) of each facet
+  std::vector<int> of;           // group (its lowest facet index) of each facet
+  std::vector<int> next_member;  // the members of group g: g, next_member[g], ... until -1
   bool merged = false;
 };
 
@@ -152,7 +154,10 @@ struct Groups {
 Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
                       const Connectivity& k, const std::vector<FacetGeometry>& geo, double limit) {
   const int nf = soup.size();
-  std::vector<int> parent(nf), reference(nf), next_member(nf, -1), last_member(nf);
+  Groups out;
+  std::vector<int>& next_member = out.next_member;
+  next_member.assign(nf, -1);
+  std::vector<int> parent(nf), reference(nf), last_member(nf);
   std::iota(parent.begin(), parent.end(), 0);
   std::iota(reference.begin(), reference.end(), 0);
   std::iota(last_member.begin(), last_member.end(), 0);
@@ -169,7 +174,6 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
         if (std::abs(dot(p.normal, points[soup.vertex[c]]) - p.offset) > limit) return false;
     return true;
   };
-  Groups out;
   const int nc = static_cast<int>(soup.vertex.size());
   for (int c = 0; c < nc; ++c) {
     const int t = k.twin[c];
@@ -193,9 +197,8 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
 
 /// Corner (interior angle) test of a polygon against its plane's normal: no corner is
 /// reflex by more than `limit`.
-bool convex_polygon(const std::vector<V3<double>>& points, const std::vector<int>& cycle,
+bool convex_polygon(const std::vector<V3<double>>& points, const int* cycle, int d,
                     const V3<double>& normal, double limit) {
-  const int d = static_cast<int>(cycle.size());
   for (int i = 0; i < d; ++i) {
     const auto& a = points[cycle[i]];
     const auto& b = points[cycle[i + 1 < d ? i + 1 : i + 1 - d]];
@@ -258,45 +261,55 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
   changed = groups.merged || dropped;
   if (!changed) return true;
   // The boundary of each group, walked from its first boundary corner.
-  std::vector<char> walked(nc, 0);
   Soup out;
   out.begin.reserve(nf + 1);
   out.vertex.reserve(nc);
   out.source.reserve(nf);
-  std::vector<int> cycle;
   std::vector<int> largest(nf, -1);  // the group's largest facet gives its source
   for (int f = 0; f < nf; ++f) {
     int& l = largest[groups.of[f]];
     if (l < 0 || geo[f].twice_area > geo[l].twice_area) l = f;
   }
-  std::vector<int> first_boundary(nf, -1);
-  for (int c = 0; c < nc; ++c)
-    if (group(c) != group(k.twin[c]) && first_boundary[group(c)] < 0) first_boundary[group(c)] = c;
   for (int g = 0; g < nf; ++g) {
     if (groups.of[g] != g) continue;
-    const int start = first_boundary[g];
-    if (start < 0) return false;  // a group without boundary: everything is flat
-    cycle.clear();
-    int c = start, steps = 0;
-    do {
-      walked[c] = 1;
-      if (keep[soup.vertex[c]]) cycle.push_back(soup.vertex[c]);
-      // The next boundary corner: turn around the edge's end inside the group.
-      int n = k.next[c];
-      while (group(k.twin[n]) == g) {
-        n = k.next[k.twin[n]];
+    // The group's first boundary corner and its number of boundary corners, from its members.
+    int start = nc, boundary = 0;
+    for (int f = g; f >= 0; f = groups.next_member[f])
+      for (int c = soup.begin[f]; c < soup.begin[f + 1]; ++c)
+        if (group(k.twin[c]) != g) {
+          start = std::min(start, c);
+          ++boundary;
+        }
+    if (boundary == 0) return false;  // a group without boundary: everything is flat
+    const int first = static_cast<int>(out.vertex.size());
+    if (groups.next_member[g] < 0 && boundary == soup.degree(g)) {
+      // A facet alone with all its edges on the boundary is its own boundary cycle.
+      for (int c = soup.begin[g]; c < soup.begin[g + 1]; ++c)
+        if (keep[soup.vertex[c]]) out.vertex.push_back(soup.vertex[c]);
+    } else {
+      int c = start, steps = 0, walked = 0;
+      do {
+        ++walked;
+        if (keep[soup.vertex[c]]) out.vertex.push_back(soup.vertex[c]);
+        // The next boundary corner: turn around the edge's end inside the group.
+        int n = k.next[c];
+        while (group(k.twin[n]) == g) {
+          n = k.next[k.twin[n]];
+          if (++steps > nc) return false;
+        }
+        c = n;
         if (++steps > nc) return false;
-      }
-      c = n;
-      if (++steps > nc) return false;
-    } while (c != start);
-    if (cycle.size() < 3 || !convex_polygon(points, cycle, geo[largest[g]].normal, limit))
+      } while (c != start);
+      // Turning to the next boundary corner is a permutation of them (a closed manifold):
+      // the walk missed some when the group has a second boundary cycle, so is not a disc.
+      if (walked != boundary) return false;
+    }
+    const int d = static_cast<int>(out.vertex.size()) - first;
+    if (d < 3 || !convex_polygon(points, out.vertex.data() + first, d, geo[largest[g]].normal, limit))
       return false;
-    out.add(cycle, soup.source[largest[g]]);
+    out.begin.push_back(static_cast<int>(out.vertex.size()));
+    out.source.push_back(soup.source[largest[g]]);
   }
-  // A group with a second boundary cycle is not a disc.
-  for (int c = 0; c < nc; ++c)
-    if (group(c) != group(k.twin[c]) && !walked[c]) return false;
   merged = std::move(out);
   return true;
 }
