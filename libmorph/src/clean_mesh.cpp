@@ -219,7 +219,8 @@ bool convex_polygon(const std::vector<V3<double>>& points, const int* cycle, int
 /// group is not one disc or its polygon is not convex; `strict`: also when a needle finds
 /// no group.
 bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, const Connectivity& k,
-                    double limit, bool strict, Soup& merged, bool& changed) {
+                    double limit, bool strict, Soup& merged, std::vector<int>& merged_twin,
+                    bool& changed) {
   const int nf = soup.size();
   std::vector<FacetGeometry> geo(nf);
   for (int f = 0; f < nf; ++f) geo[f] = geometry(points, soup, f);
@@ -265,6 +266,11 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
   out.begin.reserve(nf + 1);
   out.vertex.reserve(nc);
   out.source.reserve(nf);
+  // A merged corner is a chain of boundary corners from a kept vertex to the next. The
+  // chain of its twin starts where the twin of its chain's last corner does.
+  std::vector<int> chain_of(nc);  // boundary corner starting a chain -> merged corner
+  std::vector<int> chain_end;     // merged corner -> its chain's last boundary corner
+  chain_end.reserve(nc);
   std::vector<int> largest(nf, -1);  // the group's largest facet gives its source
   for (int f = 0; f < nf; ++f) {
     int& l = largest[groups.of[f]];
@@ -282,15 +288,27 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
         }
     if (boundary == 0) return false;  // a group without boundary: everything is flat
     const int first = static_cast<int>(out.vertex.size());
+    int before_first = -1;  // the last corner walked before the first kept one
+    const auto add = [&](int c) {
+      if (keep[soup.vertex[c]]) {
+        chain_of[c] = static_cast<int>(out.vertex.size());
+        out.vertex.push_back(soup.vertex[c]);
+        chain_end.push_back(c);
+      } else if (static_cast<int>(out.vertex.size()) == first) {
+        before_first = c;
+      } else {
+        chain_end.back() = c;
+      }
+    };
     if (groups.next_member[g] < 0 && boundary == soup.degree(g)) {
       // A facet alone with all its edges on the boundary is its own boundary cycle.
       for (int c = soup.begin[g]; c < soup.begin[g + 1]; ++c)
-        if (keep[soup.vertex[c]]) out.vertex.push_back(soup.vertex[c]);
+        add(c);
     } else {
       int c = start, steps = 0, walked = 0;
       do {
         ++walked;
-        if (keep[soup.vertex[c]]) out.vertex.push_back(soup.vertex[c]);
+        add(c);
         // The next boundary corner: turn around the edge's end inside the group.
         int n = k.next[c];
         while (group(k.twin[n]) == g) {
@@ -305,13 +323,64 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
       if (walked != boundary) return false;
     }
     const int d = static_cast<int>(out.vertex.size()) - first;
+    if (before_first >= 0 && d > 0) chain_end.back() = before_first;  // the chain wraps
     if (d < 3 || !convex_polygon(points, out.vertex.data() + first, d, geo[largest[g]].normal, limit))
       return false;
     out.begin.push_back(static_cast<int>(out.vertex.size()));
     out.source.push_back(soup.source[largest[g]]);
   }
+  merged_twin.resize(chain_end.size());
+  for (std::size_t m = 0; m < chain_end.size(); ++m) merged_twin[m] = chain_of[k.twin[chain_end[m]]];
   merged = std::move(out);
   return true;
+}
+
+/// The connectivity of a soup with the given twin candidates, or nothing when they are not
+/// those `connect` would find (it then decides): each candidate must be the reverse edge,
+/// pairing must be mutual, and each vertex must have one fan with no two edges to one vertex.
+/// Then the soup is a closed, oriented 2-manifold whose reverse edges are unique, so
+/// `connect` would succeed with these twins.
+std::optional<Connectivity> connect_with(int num_points, const Soup& soup,
+                                         std::vector<int>&& twin) {
+  const int nc = static_cast<int>(soup.vertex.size());
+  Connectivity k;
+  k.face.resize(nc);
+  k.next.resize(nc);
+  k.prev.resize(nc);
+  for (int f = 0; f < soup.size(); ++f) {
+    const int b = soup.begin[f], e = soup.begin[f + 1];
+    for (int c = b; c < e; ++c) {
+      k.face[c] = f;
+      k.next[c] = c + 1 == e ? b : c + 1;
+      k.prev[c] = c == b ? e - 1 : c - 1;
+    }
+  }
+  k.twin = std::move(twin);
+  std::vector<int> out_count(num_points, 0), mark(num_points, -1);
+  for (int c = 0; c < nc; ++c) {
+    const int t = k.twin[c];
+    if (t < 0 || t >= nc || t == c || k.twin[t] != c || soup.vertex[t] != soup.vertex[k.next[c]] ||
+        soup.vertex[k.next[t]] != soup.vertex[c])
+      return std::nullopt;
+    ++out_count[soup.vertex[c]];
+  }
+  for (int s = 0; s < nc; ++s) {
+    const int v = soup.vertex[s];
+    if (out_count[v] < 0) continue;  // its fan is checked
+    // Turning from an outgoing edge to the next is a permutation of the corners leaving v:
+    // one fan when its orbit holds all of them.
+    int c = s, steps = 0;
+    do {
+      int& m = mark[soup.vertex[k.next[c]]];
+      if (m == v) return std::nullopt;  // v -> w twice
+      m = v;
+      c = k.twin[k.prev[c]];
+      ++steps;
+    } while (c != s && steps <= out_count[v]);
+    if (steps != out_count[v] || c != s) return std::nullopt;
+    out_count[v] = -1;
+  }
+  return k;
 }
 
 /// Passes 2 and 3, then connectivity of the result. Strict: nothing when the soup is not
@@ -322,14 +391,17 @@ std::optional<std::pair<Soup, Connectivity>> simplify(const std::vector<V3<doubl
   std::optional<Connectivity> k = connect(static_cast<int>(points.size()), soup);
   if (!k) return std::nullopt;
   Soup merged;
+  std::vector<int> merged_twin;
   bool changed = false;
-  if (!merge_coplanar(points, soup, *k, limit, strict, merged, changed)) {
+  if (!merge_coplanar(points, soup, *k, limit, strict, merged, merged_twin, changed)) {
     if (strict) return std::nullopt;
     return std::make_pair(std::move(soup), std::move(*k));
   }
   if (!changed) return std::make_pair(std::move(soup), std::move(*k));
   if (strict) k.reset();  // no use for it any more: its memory serves the next one
-  std::optional<Connectivity> km = connect(static_cast<int>(points.size()), merged);
+  std::optional<Connectivity> km =
+      connect_with(static_cast<int>(points.size()), merged, std::move(merged_twin));
+  if (!km) km = connect(static_cast<int>(points.size()), merged);
   if (km) return std::make_pair(std::move(merged), std::move(*km));
   if (strict) return std::nullopt;
   return std::make_pair(std::move(soup), std::move(*k));
