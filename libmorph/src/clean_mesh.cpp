@@ -264,13 +264,13 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
   // The boundary of each group, walked from its first boundary corner.
   Soup out;
   out.begin.reserve(nf + 1);
-  out.vertex.reserve(nc);
+  out.vertex.resize(nc);  // no more corners than the soup's; filled up to `size`
+  int size = 0;
   out.source.reserve(nf);
   // A merged corner is a chain of boundary corners from a kept vertex to the next. The
   // chain of its twin starts where the twin of its chain's last corner does.
   std::vector<int> chain_of(nc);  // boundary corner starting a chain -> merged corner
-  std::vector<int> chain_end;     // merged corner -> its chain's last boundary corner
-  chain_end.reserve(nc);
+  std::vector<int> chain_end(nc);  // merged corner -> its chain's last boundary corner
   std::vector<int> largest(nf, -1);  // the group's largest facet gives its source
   for (int f = 0; f < nf; ++f) {
     int& l = largest[groups.of[f]];
@@ -287,17 +287,17 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
           ++boundary;
         }
     if (boundary == 0) return false;  // a group without boundary: everything is flat
-    const int first = static_cast<int>(out.vertex.size());
+    const int first = size;
     int before_first = -1;  // the last corner walked before the first kept one
     const auto add = [&](int c) {
       if (keep[soup.vertex[c]]) {
-        chain_of[c] = static_cast<int>(out.vertex.size());
-        out.vertex.push_back(soup.vertex[c]);
-        chain_end.push_back(c);
-      } else if (static_cast<int>(out.vertex.size()) == first) {
+        chain_of[c] = size;
+        out.vertex[size] = soup.vertex[c];
+        chain_end[size++] = c;
+      } else if (size == first) {
         before_first = c;
       } else {
-        chain_end.back() = c;
+        chain_end[size - 1] = c;
       }
     };
     if (groups.next_member[g] < 0 && boundary == soup.degree(g)) {
@@ -307,7 +307,9 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
     } else {
       int c = start, steps = 0, walked = 0;
       do {
-        ++walked;
+        // More corners than the group's boundary has: the walk cannot end well (and the
+        // merged corners stay within the soup's).
+        if (++walked > boundary) return false;
         add(c);
         // The next boundary corner: turn around the edge's end inside the group.
         int n = k.next[c];
@@ -322,15 +324,16 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
       // the walk missed some when the group has a second boundary cycle, so is not a disc.
       if (walked != boundary) return false;
     }
-    const int d = static_cast<int>(out.vertex.size()) - first;
-    if (before_first >= 0 && d > 0) chain_end.back() = before_first;  // the chain wraps
+    const int d = size - first;
+    if (before_first >= 0 && d > 0) chain_end[size - 1] = before_first;  // the chain wraps
     if (d < 3 || !convex_polygon(points, out.vertex.data() + first, d, geo[largest[g]].normal, limit))
       return false;
-    out.begin.push_back(static_cast<int>(out.vertex.size()));
+    out.begin.push_back(size);
     out.source.push_back(soup.source[largest[g]]);
   }
-  merged_twin.resize(chain_end.size());
-  for (std::size_t m = 0; m < chain_end.size(); ++m) merged_twin[m] = chain_of[k.twin[chain_end[m]]];
+  out.vertex.resize(size);
+  merged_twin.resize(size);
+  for (int m = 0; m < size; ++m) merged_twin[m] = chain_of[k.twin[chain_end[m]]];
   merged = std::move(out);
   return true;
 }
