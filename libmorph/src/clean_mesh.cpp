@@ -11,6 +11,8 @@
 // When the facets no longer describe a closed manifold after pass 1 or a merged polygon
 // is not convex to within the feature size, the mesh is rebuilt instead from the convex
 // hull of the points (exact predicates), whose exact facets go through passes 2 and 3.
+// Edges are matched into twins once (`connect`); the merged polygons' twins are read off
+// those and only checked (`connect_with`).
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/convex_hull_3.h>
