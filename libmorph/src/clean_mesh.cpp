@@ -52,15 +52,13 @@ struct Connectivity {
   std::vector<int> face, next, prev, twin;
 };
 
-/// Twins of every corner, or nothing when the soup is not a closed, oriented 2-manifold
-/// (an edge used twice in one direction or only once, a vertex with several fans).
-std::optional<Connectivity> connect(int num_points, const Soup& soup) {
+/// The facet, next and previous corner of every corner (no twins yet).
+Connectivity facet_cycles(const Soup& soup) {
   const int nc = static_cast<int>(soup.vertex.size());
   Connectivity k;
   k.face.resize(nc);
   k.next.resize(nc);
   k.prev.resize(nc);
-  k.twin.assign(nc, -1);
   for (int f = 0; f < soup.size(); ++f) {
     const int b = soup.begin[f], e = soup.begin[f + 1];
     for (int c = b; c < e; ++c) {
@@ -69,6 +67,15 @@ std::optional<Connectivity> connect(int num_points, const Soup& soup) {
       k.prev[c] = c == b ? e - 1 : c - 1;
     }
   }
+  return k;
+}
+
+/// Twins of every corner, or nothing when the soup is not a closed, oriented 2-manifold
+/// (an edge used twice in one direction or only once, a vertex with several fans).
+std::optional<Connectivity> connect(int num_points, const Soup& soup) {
+  const int nc = static_cast<int>(soup.vertex.size());
+  Connectivity k = facet_cycles(soup);
+  k.twin.assign(nc, -1);
   // Outgoing corners of each vertex (counting sort).
   std::vector<int> out_begin(num_points + 1, 0), out(nc);
   for (int c = 0; c < nc; ++c) ++out_begin[soup.vertex[c]];
@@ -348,18 +355,7 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
 std::optional<Connectivity> connect_with(int num_points, const Soup& soup,
                                          std::vector<int>&& twin) {
   const int nc = static_cast<int>(soup.vertex.size());
-  Connectivity k;
-  k.face.resize(nc);
-  k.next.resize(nc);
-  k.prev.resize(nc);
-  for (int f = 0; f < soup.size(); ++f) {
-    const int b = soup.begin[f], e = soup.begin[f + 1];
-    for (int c = b; c < e; ++c) {
-      k.face[c] = f;
-      k.next[c] = c + 1 == e ? b : c + 1;
-      k.prev[c] = c == b ? e - 1 : c - 1;
-    }
-  }
+  Connectivity k = facet_cycles(soup);
   k.twin = std::move(twin);
   std::vector<int> out_count(num_points, 0), mark(num_points, -1);
   for (int c = 0; c < nc; ++c) {
