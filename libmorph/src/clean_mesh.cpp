@@ -52,6 +52,22 @@ struct Connectivity {
   std::vector<int> face, next, prev, twin;
 };
 
+/// Disjoint sets of 0..n-1 (path halving), each named by its lowest member.
+struct LowestSets {
+  std::vector<int> parent;
+  explicit LowestSets(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  int find(int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  /// Joins the sets named a and b (a != b); returns the joined set's name.
+  int join(int a, int b) {
+    const int root = std::min(a, b);
+    parent[std::max(a, b)] = root;
+    return root;
+  }
+};
+
 /// The facet, next and previous corner of every corner (no twins yet).
 Connectivity facet_cycles(const Soup& soup) {
   const int nc = static_cast<int>(soup.vertex.size());
@@ -166,14 +182,10 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
   Groups out;
   std::vector<int>& next_member = out.next_member;
   next_member.assign(nf, -1);
-  std::vector<int> parent(nf), reference(nf), last_member(nf);
-  std::iota(parent.begin(), parent.end(), 0);
+  LowestSets sets(nf);
+  std::vector<int> reference(nf), last_member(nf);
   std::iota(reference.begin(), reference.end(), 0);
   std::iota(last_member.begin(), last_member.end(), 0);
-  auto find = [&](int x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
   // All vertices of group `g` within `limit` of the plane of facet `ref`.
   auto holds = [&](int ref, int g) {
     const FacetGeometry& p = geo[ref];
@@ -187,20 +199,19 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
   for (int c = 0; c < nc; ++c) {
     const int t = k.twin[c];
     if (t < c) continue;
-    int a = find(k.face[c]), b = find(k.face[t]);
+    int a = sets.find(k.face[c]), b = sets.find(k.face[t]);
     if (a == b) continue;
     if (geo[reference[a]].twice_area < geo[reference[b]].twice_area) std::swap(a, b);
     // a has the larger reference facet.
     if (!holds(reference[a], b)) continue;
-    const int root = std::min(a, b), other = std::max(a, b);
-    parent[other] = root;
+    const int other = std::max(a, b), root = sets.join(a, b);
     reference[root] = reference[a];
     next_member[last_member[root]] = other;
     last_member[root] = last_member[other];
     out.merged = true;
   }
   out.of.resize(nf);
-  for (int f = 0; f < nf; ++f) out.of[f] = find(f);
+  for (int f = 0; f < nf; ++f) out.of[f] = sets.find(f);
   return out;
 }
 
@@ -492,27 +503,24 @@ Soup hull_facets(const std::vector<V3<double>>& points, const Soup& facets) {
   }
   // Groups of exactly coplanar triangles (union-find over the hull's faces).
   using Face = HullMesh::Face_index;
-  std::vector<int> parent(hull.number_of_faces());
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&](int x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
+  LowestSets groups(static_cast<int>(hull.number_of_faces()));
+  const auto group = [&](HullMesh::Halfedge_index h) {
+    return groups.find(static_cast<int>(Face(hull.face(h))));
   };
   const auto point_at = [&](HullMesh::Halfedge_index h) { return hull.point(hull.target(h)); };
   for (auto e : hull.edges()) {
     const auto h = hull.halfedge(e), o = hull.opposite(h);
-    const int a = find(static_cast<int>(Face(hull.face(h)))),
-              b = find(static_cast<int>(Face(hull.face(o))));
+    const int a = group(h), b = group(o);
     if (a == b) continue;
     if (CGAL::coplanar(point_at(h), point_at(o), point_at(hull.next(h)), point_at(hull.next(o))))
-      parent[std::max(a, b)] = std::min(a, b);
+      groups.join(a, b);
   }
   // Each group's boundary: one outgoing boundary edge per corner (a flat part of a convex
   // surface is a convex polygon), chained from the lowest point.
   std::map<int, std::map<int, int>> boundary;  // group -> (from point -> to point)
   for (auto h : hull.halfedges()) {
-    const int g = find(static_cast<int>(Face(hull.face(h))));
-    if (g == find(static_cast<int>(Face(hull.face(hull.opposite(h)))))) continue;
+    const int g = group(h);
+    if (g == group(hull.opposite(h))) continue;
     const int from = point_of.at(hull.point(hull.source(h)));
     if (!boundary[g].emplace(from, point_of.at(point_at(h))).second)
       throw error("internal error: a flat part of a hull is not a polygon");
@@ -577,12 +585,7 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
   const V3<double> span = hi - lo;
   const double limit = kFeatureTolerance * std::sqrt(dot(span, span));
   // Pass 1: clusters of close corners, each represented by its lowest vertex.
-  std::vector<int> rep(n);
-  std::iota(rep.begin(), rep.end(), 0);
-  auto find = [&](int x) {
-    while (rep[x] != x) x = rep[x] = rep[rep[x]];
-    return x;
-  };
+  LowestSets clusters(n);
   // Squared distances above `far` are beyond `limit` whatever the rounding of its square
   // (a margin of 2), so most pairs need no square root.
   const double limit_squared = limit * limit;
@@ -593,8 +596,8 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
     const V3<double> d = points[u] - points[w];
     const double distance_squared = dot(d, d);
     if (distance_squared <= far && std::sqrt(distance_squared) <= limit) {
-      const int a = find(u), b = find(w);
-      if (a != b) rep[std::max(a, b)] = std::min(a, b);
+      const int a = clusters.find(u), b = clusters.find(w);
+      if (a != b) clusters.join(a, b);
     }
   };
   for (int f = 0; f < nf; ++f) {
@@ -615,7 +618,7 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
   for (int f = 0; f < nf; ++f) {
     cycle.clear();
     for (int c = face_begin[f]; c < face_begin[f + 1]; ++c) {
-      const int v = find(corners[c]);
+      const int v = clusters.find(corners[c]);
       if (cycle.empty() || cycle.back() != v) cycle.push_back(v);
     }
     while (cycle.size() > 1 && cycle.front() == cycle.back()) cycle.pop_back();

@@ -33,12 +33,10 @@ int region_test(const Polytope& P, const std::vector<ArcPlane>& planes, int v, c
   double lowest = 0;
   for (int i = 0; i < n; ++i) {
     const int e = P.fan_edge[b + i];
-    const ArcPlane& c = planes[e];
-    double d = u.x * c.x + u.y * c.y + u.z * c.z;
-    if (flipped(i, e)) d = -d;
-    const double bound = c.error + u.error + kUnitPredicateRounding;
-    if (!(d > bound)) inside = false;
-    if (d < -bound && d < lowest) {
+    const ArcFilter f = arc_filter(planes[e], u);
+    const double d = flipped(i, e) ? -f.value : f.value;
+    if (!(d > f.bound)) inside = false;
+    if (d < -f.bound && d < lowest) {
       lowest = d;
       most = i;
     }

@@ -33,12 +33,18 @@ std::vector<ArcPlane> arc_planes(const Polytope& P);
 /// Sign of det(N_left, N_right, x) for edge e of P, whose arc's plane is `plane`.
 /// Its double stage alone: the sign, or kUndecided.
 inline constexpr int kUndecided = 2;
+/// The double stage's value of det(N_left, N_right, u) and the bound on its error.
+struct ArcFilter {
+  double value, bound;
+};
+inline ArcFilter arc_filter(const ArcPlane& plane, const UnitNormal& u) {
+  return {u.x * plane.x + u.y * plane.y + u.z * plane.z,
+          plane.error + u.error + kUnitPredicateRounding};
+}
 inline int orient_arc_filter(const ArcPlane& plane, const NormalRef& x) {
-  const UnitNormal& u = x.unit();
-  const double d = u.x * plane.x + u.y * plane.y + u.z * plane.z;
-  const double bound = plane.error + u.error + kUnitPredicateRounding;
-  if (d > bound) return 1;
-  if (d < -bound) return -1;
+  const ArcFilter f = arc_filter(plane, x.unit());
+  if (f.value > f.bound) return 1;
+  if (f.value < -f.bound) return -1;
   return kUndecided;
 }
 inline int orient_arc(const Polytope& P, int e, const ArcPlane& plane, const NormalRef& x) {
