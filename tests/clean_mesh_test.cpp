@@ -16,7 +16,8 @@ using morph::detail::V3;
 // midpoints 8 = (1/2,0,1) and 9 = (1/2,1,1) are corners of the front and back facets too.
 TEST_CASE("clean_mesh merges a split facet and drops the vertices in the middle of edges") {
   std::vector<V3<double>> points;
-  for (int v = 0; v < 8; ++v) points.push_back({double(v & 1), double((v >> 1) & 1), double(v >> 2)});
+  for (int v = 0; v < 8; ++v)
+    points.push_back({double(v & 1), double((v >> 1) & 1), double(v >> 2)});
   points.push_back({0.5, 0, 1});
   points.push_back({0.5, 1, 1});
   const std::vector<std::vector<int>> facets = {

@@ -143,7 +143,7 @@ FacetGeometry geometry(const std::vector<V3<double>>& points, const Soup& soup, 
   const V3<double>& origin = points[soup.vertex[b]];
   V3<double> sum{0, 0, 0}, centroid{0, 0, 0};
   double longest_squared = 0;  // the root is monotonic: the root of the maximum is the maximum root
-  V3<double> p{0, 0, 0};  // the corner's offset from the origin (each computed once)
+  V3<double> p{0, 0, 0};       // the corner's offset from the origin (each computed once)
   for (int k = 0; k < d; ++k) {
     const V3<double> q = k + 1 == d ? V3<double>{0, 0, 0} : points[soup.vertex[b + k + 1]] - origin;
     sum = sum + cross(p, q);  // Newell's normal (twice the vector area)
@@ -289,8 +289,8 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
   out.source.reserve(nf);
   // A merged corner is a chain of boundary corners from a kept vertex to the next. The
   // chain of its twin starts where the twin of its chain's last corner does.
-  std::vector<int> chain_of(nc);  // boundary corner starting a chain -> merged corner
-  std::vector<int> chain_end(nc);  // merged corner -> its chain's last boundary corner
+  std::vector<int> chain_of(nc);     // boundary corner starting a chain -> merged corner
+  std::vector<int> chain_end(nc);    // merged corner -> its chain's last boundary corner
   std::vector<int> largest(nf, -1);  // the group's largest facet gives its source
   for (int f = 0; f < nf; ++f) {
     int& l = largest[groups.of[f]];
@@ -322,8 +322,7 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
     };
     if (groups.next_member[g] < 0 && boundary == soup.degree(g)) {
       // A facet alone with all its edges on the boundary is its own boundary cycle.
-      for (int c = soup.begin[g]; c < soup.begin[g + 1]; ++c)
-        add(c);
+      for (int c = soup.begin[g]; c < soup.begin[g + 1]; ++c) add(c);
     } else {
       int c = start, steps = 0, walked = 0;
       do {
@@ -346,7 +345,8 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
     }
     const int d = size - first;
     if (before_first >= 0 && d > 0) chain_end[size - 1] = before_first;  // the chain wraps
-    if (d < 3 || !convex_polygon(points, out.vertex.data() + first, d, geo[largest[g]].normal, limit))
+    if (d < 3 ||
+        !convex_polygon(points, out.vertex.data() + first, d, geo[largest[g]].normal, limit))
       return false;
     out.begin.push_back(size);
     out.source.push_back(soup.source[largest[g]]);

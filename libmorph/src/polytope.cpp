@@ -324,7 +324,7 @@ int orient_normals_undecided(const NormalRef& a, const NormalRef& b, const Norma
 }
 
 int cross_dot_normals_undecided(const NormalRef& a, const NormalRef& b, const NormalRef& c,
-                            const NormalRef& d) {
+                                const NormalRef& d) {
   {
     // As orient_normals_undecided: double-double on precise normals (nearly parallel
     // normals give values far below what doubles resolve), in round-to-nearest.

@@ -367,8 +367,8 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
   const double diagonal = geometry.extent.diagonal;
   if (!(diagonal >= kMinSize && diagonal <= kMaxSize))
     return fail(Verdict::invalid, "the mesh's size (bounding-box diagonal " + number(diagonal) +
-                                      ") is outside the supported range [" + number(kMinSize) + ", " +
-                                      number(kMaxSize) + "]");
+                                      ") is outside the supported range [" + number(kMinSize) +
+                                      ", " + number(kMaxSize) + "]");
   const double tolerance = relative_tolerance * diagonal;
   geometry.cycles = face_cycles(m);
   for (int f = 0; f < m.n_faces; ++f) {
