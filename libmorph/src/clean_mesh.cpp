@@ -27,6 +27,7 @@
 #include <optional>
 
 #include "fims.h"
+#include "union_find.h"
 
 namespace morph::detail {
 
@@ -50,22 +51,6 @@ struct Soup {
 /// corner's vertex; twin[c] the corner of the opposite edge.
 struct Connectivity {
   std::vector<int> face, next, prev, twin;
-};
-
-/// Disjoint sets of 0..n-1 (path halving), each named by its lowest member.
-struct LowestSets {
-  std::vector<int> parent;
-  explicit LowestSets(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-  int find(int x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  }
-  /// Joins the sets named a and b (a != b); returns the joined set's name.
-  int join(int a, int b) {
-    const int root = std::min(a, b);
-    parent[std::max(a, b)] = root;
-    return root;
-  }
 };
 
 /// The facet, next and previous corner of every corner (no twins yet).
@@ -182,7 +167,7 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
   Groups out;
   std::vector<int>& next_member = out.next_member;
   next_member.assign(nf, -1);
-  LowestSets sets(nf);
+  UnionFind sets(nf);
   std::vector<int> reference(nf), last_member(nf);
   std::iota(reference.begin(), reference.end(), 0);
   std::iota(last_member.begin(), last_member.end(), 0);
@@ -204,7 +189,8 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
     if (geo[reference[a]].twice_area < geo[reference[b]].twice_area) std::swap(a, b);
     // a has the larger reference facet.
     if (!holds(reference[a], b)) continue;
-    const int other = std::max(a, b), root = sets.join(a, b);
+    const int root = std::min(a, b), other = std::max(a, b);
+    sets.unite(a, b);  // names the joined set `root`
     reference[root] = reference[a];
     next_member[last_member[root]] = other;
     last_member[root] = last_member[other];
@@ -503,7 +489,7 @@ Soup hull_facets(const std::vector<V3<double>>& points, const Soup& facets) {
   }
   // Groups of exactly coplanar triangles (union-find over the hull's faces).
   using Face = HullMesh::Face_index;
-  LowestSets groups(static_cast<int>(hull.number_of_faces()));
+  UnionFind groups(static_cast<int>(hull.number_of_faces()));
   const auto group = [&](HullMesh::Halfedge_index h) {
     return groups.find(static_cast<int>(Face(hull.face(h))));
   };
@@ -513,7 +499,7 @@ Soup hull_facets(const std::vector<V3<double>>& points, const Soup& facets) {
     const int a = group(h), b = group(o);
     if (a == b) continue;
     if (CGAL::coplanar(point_at(h), point_at(o), point_at(hull.next(h)), point_at(hull.next(o))))
-      groups.join(a, b);
+      groups.unite(a, b);
   }
   // Each group's boundary: one outgoing boundary edge per corner (a flat part of a convex
   // surface is a convex polygon), chained from the lowest point.
@@ -585,7 +571,7 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
   const V3<double> span = hi - lo;
   const double limit = kFeatureTolerance * std::sqrt(dot(span, span));
   // Pass 1: clusters of close corners, each represented by its lowest vertex.
-  LowestSets clusters(n);
+  UnionFind clusters(n);
   // Squared distances above `far` are beyond `limit` whatever the rounding of its square
   // (a margin of 2), so most pairs need no square root.
   const double limit_squared = limit * limit;
@@ -596,8 +582,7 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
     const V3<double> d = points[u] - points[w];
     const double distance_squared = dot(d, d);
     if (distance_squared <= far && std::sqrt(distance_squared) <= limit) {
-      const int a = clusters.find(u), b = clusters.find(w);
-      if (a != b) clusters.join(a, b);
+      clusters.unite(u, w);
     }
   };
   for (int f = 0; f < nf; ++f) {

@@ -12,6 +12,7 @@
 #include <unordered_map>
 
 #include "parallel.h"
+#include "union_find.h"
 #include "validate_detail.h"
 
 namespace morph::detail {
@@ -372,20 +373,6 @@ std::uint64_t key(int u, int w) {
   return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(u)) << 32) |
          static_cast<std::uint32_t>(w);
 }
-
-struct UnionFind {
-  std::vector<int> parent;
-  explicit UnionFind(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-  int find(int x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  }
-  void unite(int a, int b) {
-    a = find(a);
-    b = find(b);
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);
-  }
-};
 
 [[noreturn]] void fail(const char* name, const std::string& what) {
   throw not_convex(std::string(name) + ": " + what);
