@@ -857,18 +857,14 @@ DualSurface expected_surface(const ExpectedVertices& expected) {
   const int nt = static_cast<int>(s.corner.size());
   std::unordered_map<std::uint64_t, int> edge_of;  // directed edge (a, b) -> 3 t + k
   edge_of.reserve(3 * static_cast<std::size_t>(nt));
-  const auto key = [](int a, int b) {
-    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
-           static_cast<std::uint32_t>(b);
-  };
   for (int t = 0; t < nt; ++t)
     for (int k = 0; k < 3; ++k)
-      if (!edge_of.emplace(key(s.corner[t][k], s.corner[t][(k + 1) % 3]), 3 * t + k).second)
+      if (!edge_of.emplace(pair_key(s.corner[t][k], s.corner[t][(k + 1) % 3]), 3 * t + k).second)
         return {};
   s.across.resize(nt);
   for (int t = 0; t < nt; ++t) {
     for (int k = 0; k < 3; ++k) {
-      const auto it = edge_of.find(key(s.corner[t][(k + 1) % 3], s.corner[t][k]));
+      const auto it = edge_of.find(pair_key(s.corner[t][(k + 1) % 3], s.corner[t][k]));
       if (it == edge_of.end()) return {};
       s.across[t][k] = it->second / 3;
     }
