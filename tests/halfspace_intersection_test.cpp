@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -103,6 +104,27 @@ MaybePolytope checked(const std::vector<HalfSpace>& hs, const V3<double>& hint =
                    }));
   CHECK(rounded.rounded.corner_vertex == fast.rounded.corner_vertex);
   return fast;
+}
+
+const morph::Mesh& sample(const std::string& name) {
+  static std::map<std::string, morph::Mesh> cache;
+  auto it = cache.find(name);
+  if (it == cache.end())
+    it = cache.emplace(name, morph::read_mesh(std::string(MORPH_SAMPLES_DIR) + "/" + name)).first;
+  return it->second;
+}
+
+/// A (-) B by erode_polytope's guess (A's vertices), by the incremental hull alone and by
+/// the exact route: exactly the same result. Returns the first.
+MaybePolytope eroded_three_ways(const Polytope& A, const Polytope& B) {
+  const MaybePolytope guessed = erode_polytope(A, B);
+  const MaybePolytope hull = erode_polytope(A, B, {.guess = false});
+  const MaybePolytope exact = erode_polytope(A, B, {.incremental = false});
+  CHECK(hull.route != HullRoute::expected);
+  CHECK(difference(guessed, hull) == "");
+  CHECK(difference(guessed, exact) == "");
+  CHECK(rounded_from_exact(guessed));
+  return guessed;
 }
 
 }  // namespace
@@ -306,9 +328,90 @@ TEST_CASE("halfspace_intersection: a closing's expected result") {
     const Polytope A = make_operand(sample(name), "A");
     const Polytope S = sum_polytope(A, B, fims_facets(A, B));
     const MaybePolytope closed = erode_sum(S, A, B);
-    const MaybePolytope hull = erode_polytope(S, B);
+    const MaybePolytope hull = erode_polytope(S, B, {.guess = false});
     CHECK(difference(closed, hull) == "");
     CHECK(rounded_from_exact(closed));
     CHECK((closed.route == HullRoute::expected) == (std::string(name) != "uvsphere_1600.off"));
   }
+}
+
+// An erosion by a small element is A with its facets moved in: each vertex of A whose
+// facets are moved by different vertices of B opens up into several vertices, which the
+// guess finds by flipping the triangulation of the vertex's polygon of planes. It is taken
+// (no hull), and the result is the hull's and the exact route's.
+TEST_CASE("halfspace_intersection: an erosion by a small element is guessed from A") {
+  const Polytope B = make_operand(morph::test::scaled(sample("icosphere_80.off"), 1.0 / 32), "B");
+  const Polytope C = make_operand(morph::test::rotated_cube_triangles(1.0 / 16, 7), "C");
+  for (const char* name : {"icosphere_320.off", "icosphere_1280.off", "dodecahedron.off",
+                           "snub_dodecahedron.off", "truncated_octahedron.off", "cylinder_16.off",
+                           "random_hull_200.off", "uvsphere_1600.off", "cube.off"}) {
+    CAPTURE(std::string(name));
+    const Polytope A = make_operand(sample(name), "A");
+    for (const Polytope* element : {&B, &C}) {
+      const MaybePolytope r = eroded_three_ways(A, *element);
+      REQUIRE(r.polytope);
+      CHECK(r.route == HullRoute::expected);
+      CHECK(r.polytope->num_faces() == A.num_faces());
+      // The spheres' vertices of degree 5 or more opened up (their facets are moved by
+      // different vertices of the element).
+      CHECK(r.polytope->num_vertices() >= A.num_vertices());
+      if (std::string(name).find("sphere") != std::string::npos)
+        CHECK(r.polytope->num_vertices() > A.num_vertices());
+    }
+  }
+}
+
+// Random polytopes and elements of several sizes: whether the guess is taken or not (a
+// facet of A vanishes, an edge collapses), the result is the hull's and the exact route's.
+TEST_CASE("halfspace_intersection: erosions of random polytopes, guessed or not") {
+  int guessed = 0, rejected = 0;
+  for (std::uint64_t seed = 1; seed <= 12; ++seed) {
+    for (const double size : {0.02, 0.1, 0.4}) {
+      CAPTURE(seed);
+      CAPTURE(size);
+      const Polytope A = make_operand(morph::test::random_sphere_polytope(60, seed), "A");
+      const morph::Mesh B =
+          seed % 3 == 0 ? morph::test::random_integer_polytope(8, seed, 2)
+                        : morph::test::random_sphere_polytope(10 + static_cast<int>(seed), seed + 50);
+      const MaybePolytope r =
+          eroded_three_ways(A, make_operand(morph::test::scaled(B, size), "B"));
+      (r.route == HullRoute::expected ? guessed : rejected)++;
+    }
+  }
+  MESSAGE(guessed << " erosions guessed, " << rejected << " computed by the hull");
+  CHECK(guessed > 0);
+  CHECK(rejected > 0);
+}
+
+// Guesses that are wrong: a sliver facet of A (a corner of the cube cut by 2^-10) vanishes
+// under an octahedron (it moves the cube's facets and the sliver's by its radius, which cuts
+// the corner's vertex off the sliver's plane), and a large element collapses the edges of a sphere.
+// The check rejects the guess; the hull gives the right answer.
+TEST_CASE("halfspace_intersection: an erosion's wrong guess is rejected") {
+  std::vector<morph::Point> corners;
+  for (int s = 0; s < 8; ++s) {
+    const morph::Point c{s & 1 ? 1.0 : -1.0, s & 2 ? 1.0 : -1.0, s & 4 ? 1.0 : -1.0};
+    if (s != 7) {
+      corners.push_back(c);
+      continue;
+    }
+    const double cut = 1 - 0x1p-10;
+    corners.push_back({cut, 1, 1});
+    corners.push_back({1, cut, 1});
+    corners.push_back({1, 1, cut});
+  }
+  const Polytope A = make_operand(morph::test::convex_hull_mesh(corners), "A");
+  REQUIRE(A.num_faces() >= 7);
+  const MaybePolytope sliver = eroded_three_ways(A, make_operand(morph::test::octahedron(0.25), "B"));
+  REQUIRE(sliver.polytope);
+  CHECK(sliver.route == HullRoute::incremental);
+  CHECK(sliver.polytope->num_vertices() == 8);  // a cube: the sliver is gone
+  const Polytope S = make_operand(sample("icosphere_320.off"), "A");
+  const MaybePolytope big = eroded_three_ways(
+      S, make_operand(morph::test::scaled(morph::test::transformed(sample("icosphere_80.off"),
+                                                                   morph::test::random_rotation(3)),
+                                          0.6),
+                      "B"));
+  REQUIRE(big.polytope);
+  CHECK(big.route == HullRoute::incremental);
 }

@@ -842,19 +842,117 @@ HalfSpace make_halfspace(const V3<ExactN>& normal, const Exact& offset, int sour
   return {normal, integer_n(offset.numerator()), integer_n(offset.denominator()), source};
 }
 
-/// The dual surface of an expected result: each vertex's facets fanned into triangles
-/// (counter-clockwise seen from outside, as the dual hull's), joined across shared edges.
-/// Empty when the fans do not close up into a surface.
-DualSurface expected_surface(const ExpectedVertices& expected) {
+namespace {
+
+/// A known point on all of the planes p[0 .. k), or -1.
+int common_point(const KnownPoints& known, const int* p, int k) {
+  if (known.empty()) return -1;
+  for (int j = known.begin[p[0]]; j < known.begin[p[0] + 1]; ++j) {
+    bool all = true;
+    for (int i = 1; i < k && all; ++i) all = known.passes(p[i], known.point[j]);
+    if (all) return known.point[j];
+  }
+  return -1;
+}
+
+/// Scratch space of triangulate_polygon, kept across the polygons of a chunk.
+struct PolygonScratch {
+  std::vector<std::array<int, 3>> triangle;  // corners: positions in the polygon
+  std::vector<HVertex> vertex;               // each triangle's vertex
+  std::vector<std::pair<int, int>> pending;  // diagonals to test
+};
+
+/// Triangulates the polygon of planes p[0 .. k) (counter-clockwise seen from outside) so
+/// that it is locally convex, as the dual hull is: Lawson flips from a fan. The diagonal
+/// (a, c) between triangles (a, c, b) and (c, a, d) is flipped to (b, d) when plane d cuts
+/// off the vertex of a, c and b (side > 0, exactly; 0 is four planes through one point,
+/// left as it is: the builder groups such triangles). Each flip makes the surface more
+/// convex, so flips stop for dual points in convex position (nearly coplanar ones, such as
+/// the moved facets around a vertex of A). Writes k - 2 triangles to `out`; false when a
+/// triangle is not positively oriented or the flips do not settle (the guess is then wrong
+/// anyway, and the hull is computed). Needs a RoundingGuard.
+bool triangulate_polygon(const std::vector<Plane>& planes, const KnownPoints& known, const int* p,
+                         int k, std::array<int, 3>* out, PolygonScratch& scratch) {
+  // Planes through one known point (facets of A moved by one vertex of B): one vertex.
+  if (k == 3 || common_point(known, p, k) >= 0) {
+    for (int i = 1; i + 1 < k; ++i) out[i - 1] = {p[0], p[i], p[i + 1]};
+    return true;
+  }
+  auto& triangle = scratch.triangle;
+  auto& vertex = scratch.vertex;
+  auto& pending = scratch.pending;
+  triangle.clear();
+  vertex.clear();
+  pending.clear();
+  const auto make_vertex = [&](const std::array<int, 3>& t, HVertex& v) {
+    const std::array<int, 3> abc{p[t[0]], p[t[1]], p[t[2]]};
+    v = vertex_of(planes, abc, known);
+    return v.Wi.inf() > 0 || det_sign(planes[abc[0]], planes[abc[1]], planes[abc[2]]) > 0;
+  };
+  for (int i = 1; i + 1 < k; ++i) {
+    triangle.push_back({0, i, i + 1});
+    vertex.emplace_back();
+    if (!make_vertex(triangle.back(), vertex.back())) return false;
+    if (i > 1) pending.emplace_back(0, i);
+  }
+  // The triangle holding the directed edge a -> c and that edge's slot in it, or -1.
+  const auto find = [&](int a, int c, int& slot) {
+    for (int t = 0; t < static_cast<int>(triangle.size()); ++t)
+      for (slot = 0; slot < 3; ++slot)
+        if (triangle[t][slot] == a && triangle[t][(slot + 1) % 3] == c) return t;
+    return -1;
+  };
+  const auto side_of = [&](int plane, HVertex& v) {
+    return known_through(known, p[plane], v) ? 0 : side(planes, planes[p[plane]], v);
+  };
+  const auto diagonal = [&](int a, int c) { return (c - a + k) % k != 1 && (a - c + k) % k != 1; };
+  for (int flips = 0; !pending.empty();) {
+    const auto [a, c] = pending.back();
+    pending.pop_back();
+    int i, j;
+    const int t = find(a, c, i), u = find(c, a, j);
+    if (t < 0 || u < 0) continue;  // flipped away meanwhile
+    const int b = triangle[t][(i + 2) % 3], d = triangle[u][(j + 2) % 3];
+    if (side_of(d, vertex[t]) <= 0) continue;
+    if (++flips > k * k) return false;
+    triangle[t] = {a, d, b};
+    triangle[u] = {d, c, b};
+    if (!make_vertex(triangle[t], vertex[t]) || !make_vertex(triangle[u], vertex[u])) return false;
+    for (const auto& e : {std::pair(a, d), std::pair(d, c), std::pair(c, b), std::pair(b, a)})
+      if (diagonal(e.first, e.second)) pending.push_back(e);
+  }
+  for (std::size_t t = 0; t < triangle.size(); ++t)
+    out[t] = {p[triangle[t][0]], p[triangle[t][1]], p[triangle[t][2]]};
+  return true;
+}
+
+/// The dual surface of an expected result: each expected vertex's polygon of planes
+/// triangulated (triangulate_polygon, in parallel; counter-clockwise seen from outside, as
+/// the dual hull's), joined across shared edges. Empty when a polygon cannot be
+/// triangulated or the triangles do not close up into a surface.
+DualSurface expected_surface(const std::vector<Plane>& planes, const KnownPoints& known,
+                             const ExpectedVertices& expected) {
   DualSurface s;
   const int nv = static_cast<int>(expected.begin.size()) - 1;
+  std::vector<int> first(nv + 1, 0);  // each polygon's first triangle
   for (int v = 0; v < nv; ++v) {
-    const int* f = &expected.facets[expected.begin[v]];
     const int k = expected.begin[v + 1] - expected.begin[v];
     if (k < 3) return {};
-    for (int i = 1; i + 1 < k; ++i) s.corner.push_back({f[0], f[i], f[i + 1]});
+    first[v + 1] = first[v] + k - 2;
   }
-  const int nt = static_cast<int>(s.corner.size());
+  const int nt = first[nv];
+  s.corner.resize(nt);
+  std::atomic<bool> ok = true;
+  parallel_chunks(nv, 64, [&](int begin, int end) {
+    RoundingGuard guard;
+    PolygonScratch scratch;
+    for (int v = begin; v < end && ok; ++v)
+      if (!triangulate_polygon(planes, known, &expected.facets[expected.begin[v]],
+                               expected.begin[v + 1] - expected.begin[v], &s.corner[first[v]],
+                               scratch))
+        ok = false;
+  });
+  if (!ok) return {};
   std::unordered_map<std::uint64_t, int> edge_of;  // directed edge (a, b) -> 3 t + k
   edge_of.reserve(3 * static_cast<std::size_t>(nt));
   for (int t = 0; t < nt; ++t)
@@ -871,6 +969,8 @@ DualSurface expected_surface(const ExpectedVertices& expected) {
   }
   return s;
 }
+
+}  // namespace
 
 MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<double>& hint,
                                    const IntersectOptions& options, const KnownPoints& known,
@@ -898,9 +998,9 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
   }
   // The verification does not depend on o: any exact interior point (there is one) makes
   // the duality argument hold, so the rounded o only has to centre the virtual planes.
-  if (options.incremental && !expected.empty()) {
-    if (auto built =
-            build_verified(hs, planes, known, expected_surface(expected), options.polytope)) {
+  if (options.incremental && options.guess && !expected.empty()) {
+    if (auto built = build_verified(hs, planes, known, expected_surface(planes, known, expected),
+                                    options.polytope)) {
       built->route = HullRoute::expected;
       return std::move(*built);
     }
@@ -1137,7 +1237,8 @@ MaybePolytope erode(const Polytope& A, const Polytope& B, const IntersectOptions
 
 MaybePolytope erode_polytope(const Polytope& A, const Polytope& B,
                              const IntersectOptions& options) {
-  return erode(A, B, options, SumOfB::no, {});
+  // Facet f of A is half-space f: A's fans are the polygons of the guess.
+  return erode(A, B, options, SumOfB::no, {A.fan_begin, A.fan_face});
 }
 
 MaybePolytope erode_sum(const Polytope& S, const Polytope& A, const Polytope& B,

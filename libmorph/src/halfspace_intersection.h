@@ -59,6 +59,7 @@ struct MaybePolytope {
 struct IntersectOptions {
   bool incremental = true;  // false: go straight to the exact hull (tests compare the routes)
   bool polytope = true;     // false: only `rounded` (a final result: no rationals, no Polytope)
+  bool guess = true;        // false: ignore the caller's ExpectedVertices (tests compare the routes)
 };
 
 /// Points known to lie exactly on some of the half-spaces' planes: an erosion knows them
@@ -89,10 +90,14 @@ struct KnownPoints {
   }
 };
 
-/// What the intersection is expected to be, when the caller knows (a closing gives A
-/// back): for each expected vertex, the half-spaces of the facets around it,
-/// counter-clockwise seen from outside (facets[begin[v]] ..). Only a guess: it is checked
-/// exactly, as any candidate, and the hull is computed when the check fails. Empty: none.
+/// What the intersection is expected to look like, when the caller knows: polygons of
+/// half-spaces, each the facets around a vertex of a polytope the result resembles
+/// (counter-clockwise seen from outside, facets[begin[v]] ..): a closing gives A back, an
+/// erosion is A with its facets moved in. The planes of a polygon may meet in several
+/// vertices (an erosion's facets around a vertex of A moved by different vertices of B):
+/// each polygon is triangulated to be locally convex, in parallel. Only a guess: it is
+/// checked exactly, as any candidate, and the hull is computed when the check fails (a
+/// facet that vanishes, an edge that collapses). Empty: none.
 struct ExpectedVertices {
   std::vector<int> begin;  // size V + 1, or empty
   std::vector<int> facets;
@@ -115,6 +120,8 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& halfspaces, con
 /// A (-) B = intersection over facets f of A of { x : <N_f, x> <= h_A(N_f) - h_B(N_f) }.
 /// The facets of A through a vertex v moved by a vertex b of B (one that attains h_B(N_f))
 /// all pass through v - b: these incidences are passed on as KnownPoints.
+/// A's vertices are the expected result (ExpectedVertices): when B is small against A's
+/// features no facet vanishes, and the hull is not needed.
 MaybePolytope erode_polytope(const Polytope& A, const Polytope& B,
                              const IntersectOptions& options = {});
 
