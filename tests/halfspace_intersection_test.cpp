@@ -370,11 +370,10 @@ TEST_CASE("halfspace_intersection: erosions of random polytopes, guessed or not"
       CAPTURE(seed);
       CAPTURE(size);
       const Polytope A = make_operand(morph::test::random_sphere_polytope(60, seed), "A");
-      const morph::Mesh B =
-          seed % 3 == 0 ? morph::test::random_integer_polytope(8, seed, 2)
-                        : morph::test::random_sphere_polytope(10 + static_cast<int>(seed), seed + 50);
-      const MaybePolytope r =
-          eroded_three_ways(A, make_operand(morph::test::scaled(B, size), "B"));
+      const morph::Mesh B = seed % 3 == 0 ? morph::test::random_integer_polytope(8, seed, 2)
+                                          : morph::test::random_sphere_polytope(
+                                                10 + static_cast<int>(seed), seed + 50);
+      const MaybePolytope r = eroded_three_ways(A, make_operand(morph::test::scaled(B, size), "B"));
       (r.route == HullRoute::expected ? guessed : rejected)++;
     }
   }
@@ -402,7 +401,8 @@ TEST_CASE("halfspace_intersection: an erosion's wrong guess is rejected") {
   }
   const Polytope A = make_operand(morph::test::convex_hull_mesh(corners), "A");
   REQUIRE(A.num_faces() >= 7);
-  const MaybePolytope sliver = eroded_three_ways(A, make_operand(morph::test::octahedron(0.25), "B"));
+  const MaybePolytope sliver =
+      eroded_three_ways(A, make_operand(morph::test::octahedron(0.25), "B"));
   REQUIRE(sliver.polytope);
   CHECK(sliver.route == HullRoute::incremental);
   CHECK(sliver.polytope->num_vertices() == 8);  // a cube: the sliver is gone

@@ -16,8 +16,9 @@
 // homogeneous coordinates, and rationals are formed only for a polytope chained further.
 // Incidences the caller knows (KnownPoints: an erosion's facets of A around a vertex moved
 // by one vertex of B) make vertices without exact constructions and zero tests free, and
-// an expected result (ExpectedVertices: a closing's A) replaces the hull when it passes
-// the check.
+// an expected result (ExpectedVertices: A's vertices, opened up by exact flips where the
+// moved planes around one no longer meet in a point; a closing's A) replaces the hull when it
+// passes the check.
 #include "halfspace_intersection.h"
 
 #include <CGAL/Lazy_kernel.h>
@@ -37,7 +38,6 @@
 #include <deque>
 #include <map>
 #include <numeric>
-#include <unordered_map>
 
 #include "fims.h"
 #include "gauss_map.h"
@@ -858,7 +858,8 @@ int common_point(const KnownPoints& known, const int* p, int k) {
 /// Scratch space of triangulate_polygon, kept across the polygons of a chunk.
 struct PolygonScratch {
   std::vector<std::array<int, 3>> triangle;  // corners: positions in the polygon
-  std::vector<HVertex> vertex;               // each triangle's vertex
+  std::vector<HVertex> vertex;               // each triangle's vertex, once tested
+  std::vector<char> ready;                   // whether it is computed
   std::vector<std::pair<int, int>> pending;  // diagonals to test
 };
 
@@ -870,7 +871,8 @@ struct PolygonScratch {
 /// convex, so flips stop for dual points in convex position (nearly coplanar ones, such as
 /// the moved facets around a vertex of A). Writes k - 2 triangles to `out`; false when a
 /// triangle is not positively oriented or the flips do not settle (the guess is then wrong
-/// anyway, and the hull is computed). Needs a RoundingGuard.
+/// anyway, and the hull is computed; a triangle never tested is left to the check). Needs
+/// a RoundingGuard.
 bool triangulate_polygon(const std::vector<Plane>& planes, const KnownPoints& known, const int* p,
                          int k, std::array<int, 3>* out, PolygonScratch& scratch) {
   // Planes through one known point (facets of A moved by one vertex of B): one vertex.
@@ -880,21 +882,25 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const KnownPoints& kn
   }
   auto& triangle = scratch.triangle;
   auto& vertex = scratch.vertex;
+  auto& ready = scratch.ready;
   auto& pending = scratch.pending;
   triangle.clear();
-  vertex.clear();
   pending.clear();
-  const auto make_vertex = [&](const std::array<int, 3>& t, HVertex& v) {
-    const std::array<int, 3> abc{p[t[0]], p[t[1]], p[t[2]]};
-    v = vertex_of(planes, abc, known);
-    return v.Wi.inf() > 0 || det_sign(planes[abc[0]], planes[abc[1]], planes[abc[2]]) > 0;
-  };
   for (int i = 1; i + 1 < k; ++i) {
     triangle.push_back({0, i, i + 1});
-    vertex.emplace_back();
-    if (!make_vertex(triangle.back(), vertex.back())) return false;
     if (i > 1) pending.emplace_back(0, i);
   }
+  vertex.resize(triangle.size());
+  ready.assign(triangle.size(), 0);
+  // Triangle t's vertex (computed when first tested); false when t is not positively
+  // oriented.
+  const auto make_vertex = [&](int t) {
+    if (ready[t]) return true;
+    ready[t] = 1;
+    const std::array<int, 3> abc{p[triangle[t][0]], p[triangle[t][1]], p[triangle[t][2]]};
+    vertex[t] = vertex_of(planes, abc, known);
+    return vertex[t].Wi.inf() > 0 || det_sign(planes[abc[0]], planes[abc[1]], planes[abc[2]]) > 0;
+  };
   // The triangle holding the directed edge a -> c and that edge's slot in it, or -1.
   const auto find = [&](int a, int c, int& slot) {
     for (int t = 0; t < static_cast<int>(triangle.size()); ++t)
@@ -913,11 +919,12 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const KnownPoints& kn
     const int t = find(a, c, i), u = find(c, a, j);
     if (t < 0 || u < 0) continue;  // flipped away meanwhile
     const int b = triangle[t][(i + 2) % 3], d = triangle[u][(j + 2) % 3];
+    if (!make_vertex(t)) return false;
     if (side_of(d, vertex[t]) <= 0) continue;
     if (++flips > k * k) return false;
     triangle[t] = {a, d, b};
     triangle[u] = {d, c, b};
-    if (!make_vertex(triangle[t], vertex[t]) || !make_vertex(triangle[u], vertex[u])) return false;
+    ready[t] = ready[u] = 0;
     for (const auto& e : {std::pair(a, d), std::pair(d, c), std::pair(c, b), std::pair(b, a)})
       if (diagonal(e.first, e.second)) pending.push_back(e);
   }
@@ -953,19 +960,26 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const KnownPoints
         ok = false;
   });
   if (!ok) return {};
-  std::unordered_map<std::uint64_t, int> edge_of;  // directed edge (a, b) -> 3 t + k
-  edge_of.reserve(3 * static_cast<std::size_t>(nt));
-  for (int t = 0; t < nt; ++t)
-    for (int k = 0; k < 3; ++k)
-      if (!edge_of.emplace(pair_key(s.corner[t][k], s.corner[t][(k + 1) % 3]), 3 * t + k).second)
-        return {};
+  // Directed edges 3 t + k (corner k to k + 1 of triangle t) listed by their first plane
+  // (a counting sort): each edge's reverse is the one edge back among the few leaving its
+  // second plane.
+  std::vector<int> out_begin(planes.size() + 1, 0), out_edge(3 * static_cast<std::size_t>(nt));
+  for (const auto& c : s.corner)
+    for (int a : c) ++out_begin[a + 1];
+  std::partial_sum(out_begin.begin(), out_begin.end(), out_begin.begin());
+  {
+    std::vector<int> next(out_begin.begin(), out_begin.end() - 1);
+    for (int e = 0; e < 3 * nt; ++e) out_edge[next[s.corner[e / 3][e % 3]]++] = e;
+  }
+  const auto head = [&](int e) { return s.corner[e / 3][(e % 3 + 1) % 3]; };
   s.across.resize(nt);
-  for (int t = 0; t < nt; ++t) {
-    for (int k = 0; k < 3; ++k) {
-      const auto it = edge_of.find(pair_key(s.corner[t][(k + 1) % 3], s.corner[t][k]));
-      if (it == edge_of.end()) return {};
-      s.across[t][k] = it->second / 3;
-    }
+  for (int e = 0; e < 3 * nt; ++e) {
+    const int a = s.corner[e / 3][e % 3], b = head(e);
+    int back = -1, found = 0;
+    for (int j = out_begin[b]; j < out_begin[b + 1]; ++j)
+      if (head(out_edge[j]) == a) back = out_edge[j], ++found;
+    if (found != 1) return {};  // an open surface, or an edge used twice
+    s.across[e / 3][e % 3] = back / 3;
   }
   return s;
 }

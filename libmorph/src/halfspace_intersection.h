@@ -59,7 +59,7 @@ struct MaybePolytope {
 struct IntersectOptions {
   bool incremental = true;  // false: go straight to the exact hull (tests compare the routes)
   bool polytope = true;     // false: only `rounded` (a final result: no rationals, no Polytope)
-  bool guess = true;        // false: ignore the caller's ExpectedVertices (tests compare the routes)
+  bool guess = true;        // false: ignore ExpectedVertices (tests compare the routes)
 };
 
 /// Points known to lie exactly on some of the half-spaces' planes: an erosion knows them
