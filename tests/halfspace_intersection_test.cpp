@@ -415,3 +415,31 @@ TEST_CASE("halfspace_intersection: an erosion's wrong guess is rejected") {
   REQUIRE(big.polytope);
   CHECK(big.route == HullRoute::incremental);
 }
+
+// The guess's flips decide exactly: an element 2^-40 times A's size (the vertices it opens up
+// lie within rounding of each other, so the filters fail and exact signs decide), operands
+// scaled by 2^+-200, and A shifted far from the origin.
+TEST_CASE("halfspace_intersection: an erosion's guess on tiny, huge and far operands") {
+  const morph::Mesh& a = sample("icosphere_320.off");
+  const morph::Mesh b =
+      morph::test::transformed(sample("icosphere_80.off"), morph::test::random_rotation(11));
+  struct Case {
+    const char* what;
+    morph::Mesh A, B;
+  };
+  const Case cases[] = {
+      {"element 2^-40", a, morph::test::scaled(b, 0x1p-40)},
+      {"scaled by 2^200", morph::test::scaled(a, 0x1p200), morph::test::scaled(b, 0x1p195)},
+      {"scaled by 2^-200", morph::test::scaled(a, 0x1p-200), morph::test::scaled(b, 0x1p-205)},
+      {"far from the origin", morph::test::translated(a, {1e6, -3e5, 7e5}),
+       morph::test::scaled(b, 1.0 / 32)},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(std::string(c.what));
+    const Polytope A = make_operand(c.A, "A");
+    const MaybePolytope r = eroded_three_ways(A, make_operand(c.B, "B"));
+    REQUIRE(r.polytope);
+    CHECK(r.route == HullRoute::expected);
+    CHECK(r.polytope->num_faces() == A.num_faces());
+  }
+}
