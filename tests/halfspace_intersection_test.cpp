@@ -406,6 +406,17 @@ TEST_CASE("halfspace_intersection: an erosion's wrong guess is rejected") {
   REQUIRE(sliver.polytope);
   CHECK(sliver.route == HullRoute::incremental);
   CHECK(sliver.polytope->num_vertices() == 8);  // a cube: the sliver is gone
+  // A cone's apex of degree 256 opens up into many vertices: the flips give up after 4 per
+  // corner (the hull is then cheaper); either way the result is the hull's.
+  std::vector<morph::Point> cone{{0, 0, 1}};
+  for (int i = 0; i < 256; ++i) {
+    const double t = 2 * M_PI * i / 256;
+    cone.push_back({std::cos(t), std::sin(t), -1});
+  }
+  const MaybePolytope apex = eroded_three_ways(
+      make_operand(morph::test::convex_hull_mesh(cone), "A"),
+      make_operand(morph::test::scaled(sample("icosphere_320.off"), 1.0 / 16), "B"));
+  REQUIRE(apex.polytope);
   const Polytope S = make_operand(sample("icosphere_320.off"), "A");
   const MaybePolytope big = eroded_three_ways(
       S, make_operand(morph::test::scaled(morph::test::transformed(sample("icosphere_80.off"),

@@ -863,6 +863,10 @@ struct PolygonScratch {
   std::vector<std::pair<int, int>> pending;  // diagonals to test
 };
 
+/// Flips per corner after which a polygon's triangulation gives up: Lawson's flips may
+/// take O(k^2) on a vertex of A of high degree, and the hull is then the cheaper route.
+constexpr int kFlipsPerCorner = 4;
+
 /// Triangulates the polygon of planes p[0 .. k) (counter-clockwise seen from outside) so
 /// that it is locally convex, as the dual hull is: Lawson flips from a fan. The diagonal
 /// (a, c) between triangles (a, c, b) and (c, a, d) is flipped to (b, d) when plane d cuts
@@ -870,9 +874,9 @@ struct PolygonScratch {
 /// left as it is: the builder groups such triangles). Each flip makes the surface more
 /// convex, so flips stop for dual points in convex position (nearly coplanar ones, such as
 /// the moved facets around a vertex of A). Writes k - 2 triangles to `out`; false when a
-/// triangle is not positively oriented or the flips do not settle (the guess is then wrong
-/// anyway, and the hull is computed; a triangle never tested is left to the check). Needs
-/// a RoundingGuard.
+/// triangle is not positively oriented or the flips take more than kFlipsPerCorner k (the
+/// guess is then likely wrong, and the hull is computed; a triangle never tested is left to
+/// the check). Needs a RoundingGuard.
 bool triangulate_polygon(const std::vector<Plane>& planes, const KnownPoints& known, const int* p,
                          int k, std::array<int, 3>* out, PolygonScratch& scratch) {
   // Planes through one known point (facets of A moved by one vertex of B): one vertex.
@@ -921,7 +925,7 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const KnownPoints& kn
     const int b = triangle[t][(i + 2) % 3], d = triangle[u][(j + 2) % 3];
     if (!make_vertex(t)) return false;
     if (side_of(d, vertex[t]) <= 0) continue;
-    if (++flips > k * k) return false;
+    if (++flips > kFlipsPerCorner * k) return false;
     triangle[t] = {a, d, b};
     triangle[u] = {d, c, b};
     ready[t] = ready[u] = 0;
