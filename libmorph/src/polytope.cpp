@@ -5,7 +5,9 @@
 #include <mpfr.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <numeric>
 #include <string>
@@ -692,6 +694,19 @@ bool has_deleted_elements(const Mesh& mesh) {
          (mesh.has_face_status() && any_deleted(mesh.face_status_pph()));
 }
 
+// Whether make_polytope may read `mesh` before it is validated: every halfedge has a face
+// (else the fan walk would follow missing corners) and every coordinate is finite (exact
+// arithmetic needs finite values). Holds for every mesh that passes the check.
+bool readable(const Mesh& mesh) {
+  const int nh = static_cast<int>(mesh.n_halfedges());
+  for (int h = 0; h < nh; ++h)
+    if (!mesh.face_handle(Mesh::HalfedgeHandle(h)).is_valid()) return false;
+  const Point* q = mesh.points();
+  for (std::size_t v = 0; v < mesh.n_vertices(); ++v)
+    if (!std::isfinite(q[v][0]) || !std::isfinite(q[v][1]) || !std::isfinite(q[v][2])) return false;
+  return true;
+}
+
 }  // namespace
 
 Polytope make_polytope(std::vector<V3<double>> points, ExactPoints exact_points,
@@ -901,8 +916,38 @@ Polytope make_polytope(const Mesh& mesh, const char* name, FaceOrder order) {
 }
 
 Polytope make_operand(const Mesh& mesh, const char* name) {
-  const bool inverted = check_operand(mesh, name).has_value();
-  return make_polytope(mesh, name, inverted ? FaceOrder::reversed : FaceOrder::as_given);
+  // The polytope is built while the mesh is checked (on another thread when there is one),
+  // as if the mesh were valid and outward: its halfedges are read before the check has
+  // passed, which is safe once every halfedge has a face and every coordinate is finite (all
+  // make_polytope's other assumptions are tested as it goes, or only make it throw). The
+  // check's verdict decides: its error wins, an inverted mesh is built again reversed, and
+  // otherwise the build's result (or error) is the one the sequential order would give.
+  std::atomic<bool> rejected{false};
+  bool inverted = false, built = false;
+  Polytope p;
+  std::exception_ptr build_error;
+  run_both(
+      [&] {
+        try {
+          inverted = check_operand(mesh, name).has_value();
+        } catch (...) {
+          rejected = true;
+          throw;
+        }
+      },
+      [&] {
+        // With one thread the check has run: skip a build it made useless.
+        if (rejected || !readable(mesh)) return;
+        try {
+          p = make_polytope(mesh, name);
+          built = true;
+        } catch (...) {
+          build_error = std::current_exception();
+        }
+      });
+  if (inverted) return make_polytope(mesh, name, FaceOrder::reversed);
+  if (build_error) std::rethrow_exception(build_error);
+  return built ? std::move(p) : make_polytope(mesh, name);
 }
 
 Operands make_operands(const Mesh& A, const Mesh& B) {
