@@ -340,7 +340,15 @@ FacePlane unit_plane(const MeshView& m, const FaceCycles& cycles, int f) {
 bool reflex_across(const MeshView& m, const FaceCycles& cycles, const FacePlane& plane, int g,
                    int from, int to, double tolerance) {
   const int* corners = cycles.corners(g);
-  for (int k = 0; k < cycles.degree(g); ++k) {
+  const int n = cycles.degree(g);
+  if (n == 3) {  // the usual case: the one corner off the edge, found without a loop
+    const int v = corners[0] != from && corners[0] != to   ? corners[0]
+                  : corners[1] != from && corners[1] != to ? corners[1]
+                                                           : corners[2];
+    // A triangle that repeats a vertex fails its own check later, which then wins.
+    return !(height(plane, m.points[v]) <= tolerance);
+  }
+  for (int k = 0; k < n; ++k) {
     const int v = corners[k];
     if (v == from || v == to) continue;
     if (!(height(plane, m.points[v]) <= tolerance)) return true;
