@@ -926,23 +926,25 @@ Polytope make_operand(const Mesh& mesh, const char* name) {
   bool inverted = false, built = false;
   Polytope p;
   std::exception_ptr build_error;
+  // The build is the first function, which never throws (its error is kept), so the check's
+  // error is the one run_both rethrows. With one thread TBB runs the second function first:
+  // the check, so a rejected mesh is not built at all.
   run_both(
       [&] {
-        try {
-          inverted = check_operand(mesh, name).has_value();
-        } catch (...) {
-          rejected = true;
-          throw;
-        }
-      },
-      [&] {
-        // With one thread the check has run: skip a build it made useless.
         if (rejected || !readable(mesh)) return;
         try {
           p = make_polytope(mesh, name);
           built = true;
         } catch (...) {
           build_error = std::current_exception();
+        }
+      },
+      [&] {
+        try {
+          inverted = check_operand(mesh, name).has_value();
+        } catch (...) {
+          rejected = true;
+          throw;
         }
       });
   if (inverted) return make_polytope(mesh, name, FaceOrder::reversed);
