@@ -252,9 +252,9 @@ TEST_CASE("polytope: make_operand keeps the messages of prepare_convex_polyhedro
 }
 
 TEST_CASE("polytope: make_operand, which builds while it checks, keeps the check's verdict") {
-  // Closed meshes whose halfedges the speculative build reads before the check rejects
-  // them (or, inverted, accepts them reversed): the check's error or fix must win, with one
-  // thread or two.
+  // Meshes whose halfedges the speculative build reads before the check rejects them (or,
+  // inverted, accepts them reversed; or, open, the build stops at): the check's error or fix
+  // must win, with one thread or two.
   const Mesh cube = morph::test::cube(2.0);
   const std::vector<Point> corners = morph::test::positions(cube);
   std::vector<std::vector<int>> quads, triangles, reversed;
@@ -266,6 +266,7 @@ TEST_CASE("polytope: make_operand, which builds while it checks, keeps the check
     triangles.push_back({q[0], q[2], q[3]});
   }
   for (const auto& t : triangles) reversed.push_back({t[2], t[1], t[0]});
+  const std::vector<std::vector<int>> open(triangles.begin(), triangles.end() - 2);  // a hole
   std::vector<Point> dented = corners, bent = corners, flat = corners;
   dented[0] *= 0.5;               // a reflex corner
   bent[0] *= 1.01;                // non-planar quads
@@ -274,7 +275,8 @@ TEST_CASE("polytope: make_operand, which builds while it checks, keeps the check
                                     morph::test::mesh_from_polygons(bent, quads),
                                     morph::test::mesh_from_polygons(flat, triangles),
                                     morph::test::mesh_from_polygons(dented, reversed),
-                                    morph::test::mesh_from_polygons(corners, reversed)};
+                                    morph::test::mesh_from_polygons(corners, reversed),
+                                    morph::test::mesh_from_polygons(corners, open)};
   for (std::size_t i = 0; i < meshes.size(); ++i) {
     CAPTURE(i);
     std::string expected;

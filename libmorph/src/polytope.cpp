@@ -616,7 +616,9 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
     int from = mesh.to_vertex_handle(h0).idx();
     auto h = start;
     do {
-      if (c == nh) throw error("internal error: a mesh face is not a closed cycle");
+      // Each halfedge once: with the count below, every halfedge is some face's.
+      if (c == nh || corner_of[h.idx()] >= 0)
+        throw error("internal error: a mesh face is not a closed cycle");
       p.corner_vertex[c] = reversed ? mesh.to_vertex_handle(h).idx() : from;
       corner_halfedge[c] = h.idx();
       link[c].face = f;
@@ -694,13 +696,12 @@ bool has_deleted_elements(const Mesh& mesh) {
          (mesh.has_face_status() && any_deleted(mesh.face_status_pph()));
 }
 
-// Whether make_polytope may read `mesh` before it is validated: every halfedge has a face
-// (else the fan walk would follow missing corners) and every coordinate is finite (exact
-// arithmetic needs finite values). Holds for every mesh that passes the check.
+// Whether make_polytope may read `mesh` before it is validated: every coordinate is finite
+// (exact arithmetic needs finite values). Holds for every mesh that passes the check. An open
+// mesh needs no test: connectivity_from_halfedges counts the corners of the face cycles
+// (each halfedge is in at most one) and throws unless they cover every halfedge, before it
+// follows any link between faces; the cycle path throws on an edge with one facet.
 bool readable(const Mesh& mesh) {
-  const int nh = static_cast<int>(mesh.n_halfedges());
-  for (int h = 0; h < nh; ++h)
-    if (!mesh.face_handle(Mesh::HalfedgeHandle(h)).is_valid()) return false;
   const Point* q = mesh.points();
   for (std::size_t v = 0; v < mesh.n_vertices(); ++v)
     if (!std::isfinite(q[v][0]) || !std::isfinite(q[v][1]) || !std::isfinite(q[v][2])) return false;
@@ -918,8 +919,8 @@ Polytope make_polytope(const Mesh& mesh, const char* name, FaceOrder order) {
 Polytope make_operand(const Mesh& mesh, const char* name) {
   // The polytope is built while the mesh is checked (on another thread when there is one),
   // as if the mesh were valid and outward: its halfedges are read before the check has
-  // passed, which is safe once every halfedge has a face and every coordinate is finite (all
-  // make_polytope's other assumptions are tested as it goes, or only make it throw). The
+  // passed, which is safe once every coordinate is finite (all make_polytope's other
+  // assumptions, a closed mesh first, are tested as it goes, or only make it throw). The
   // check's verdict decides: its error wins, an inverted mesh is built again reversed, and
   // otherwise the build's result (or error) is the one the sequential order would give.
   std::atomic<bool> rejected{false};
