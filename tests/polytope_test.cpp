@@ -7,6 +7,7 @@
 #include <morph/error.h>
 #include <morph/io.h>
 #include <morph/validate.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -247,6 +248,58 @@ TEST_CASE("polytope: make_operand keeps the messages of prepare_convex_polyhedro
     FAIL("an open mesh was accepted");
   } catch (const morph::invalid_mesh& error) {
     CHECK(std::string(error.what()) == expected);
+  }
+}
+
+TEST_CASE("polytope: make_operand, which builds while it checks, keeps the check's verdict") {
+  // Meshes whose halfedges the speculative build reads before the check rejects them (or,
+  // inverted, accepts them reversed; or, open, the build stops at): the check's error or fix
+  // must win, with one thread or two.
+  const Mesh cube = morph::test::cube(2.0);
+  const std::vector<Point> corners = morph::test::positions(cube);
+  std::vector<std::vector<int>> quads, triangles, reversed;
+  for (auto f : cube.faces()) {
+    std::vector<int> q;
+    for (auto v : f.vertices()) q.push_back(v.idx());
+    quads.push_back(q);
+    triangles.push_back({q[0], q[1], q[2]});
+    triangles.push_back({q[0], q[2], q[3]});
+  }
+  for (const auto& t : triangles) reversed.push_back({t[2], t[1], t[0]});
+  const std::vector<std::vector<int>> open(triangles.begin(), triangles.end() - 2);  // a hole
+  std::vector<Point> dented = corners, bent = corners, flat = corners;
+  dented[0] *= 0.5;               // a reflex corner
+  bent[0] *= 1.01;                // non-planar quads
+  for (auto& q : flat) q[2] = 0;  // encloses no volume
+  const std::vector<Mesh> meshes = {morph::test::mesh_from_polygons(dented, triangles),
+                                    morph::test::mesh_from_polygons(bent, quads),
+                                    morph::test::mesh_from_polygons(flat, triangles),
+                                    morph::test::mesh_from_polygons(dented, reversed),
+                                    morph::test::mesh_from_polygons(corners, reversed),
+                                    morph::test::mesh_from_polygons(corners, open)};
+  for (std::size_t i = 0; i < meshes.size(); ++i) {
+    CAPTURE(i);
+    std::string expected;
+    try {
+      morph::prepare_convex_polyhedron(meshes[i], "A");
+    } catch (const std::exception& error) {
+      expected = error.what();
+    }
+    CHECK((expected == "") == (i == 4));
+    for (int threads : {1, 2}) {
+      CAPTURE(threads);
+      tbb::task_arena arena(threads);
+      arena.execute([&] {
+        try {
+          const Polytope p = morph::detail::make_operand(meshes[i], "A");
+          CHECK(expected == "");  // the inverted cube, built reversed
+          CHECK(difference(p, morph::detail::make_polytope(meshes[i], "A", FaceOrder::reversed)) ==
+                "");
+        } catch (const std::exception& error) {
+          CHECK(std::string(error.what()) == expected);
+        }
+      });
+    }
   }
 }
 

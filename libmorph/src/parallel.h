@@ -10,16 +10,29 @@
 
 #include <algorithm>
 #include <exception>
+#include <memory>
+#include <vector>
 
 namespace morph::detail {
+
+/// The calling thread's arena of `threads` threads (at most the number of cores), made on
+/// first use and kept: a new arena per operation costs tens of microseconds at two threads
+/// (its worker is requested and woken again each time), a lot for small operands. One per
+/// calling thread, so concurrent callers each get their threads, as with an arena per call.
+inline tbb::task_arena& arena_for(int threads) {
+  // More threads than cores buys nothing and makes TBB print a warning.
+  const int n = std::min(threads, tbb::info::default_concurrency());
+  thread_local std::vector<std::unique_ptr<tbb::task_arena>> arenas;
+  if (static_cast<int>(arenas.size()) <= n) arenas.resize(n + 1);
+  if (!arenas[n]) arenas[n] = std::make_unique<tbb::task_arena>(n);
+  return *arenas[n];
+}
 
 /// Runs f() with at most `threads` worker threads (0: all cores).
 template <class F>
 auto run_with_threads(int threads, F&& f) {
   if (threads <= 0) return f();
-  // More threads than cores buys nothing and makes TBB print a warning.
-  tbb::task_arena arena(std::min(threads, tbb::info::default_concurrency()));
-  return arena.execute(std::forward<F>(f));
+  return arena_for(threads).execute(std::forward<F>(f));
 }
 
 /// Calls body(begin, end) over [0, n) in chunks of about `grain`, in parallel when n is

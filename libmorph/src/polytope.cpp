@@ -5,7 +5,9 @@
 #include <mpfr.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <numeric>
 #include <string>
@@ -614,7 +616,9 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
     int from = mesh.to_vertex_handle(h0).idx();
     auto h = start;
     do {
-      if (c == nh) throw error("internal error: a mesh face is not a closed cycle");
+      // Each halfedge once: with the count below, every halfedge is some face's.
+      if (c == nh || corner_of[h.idx()] >= 0)
+        throw error("internal error: a mesh face is not a closed cycle");
       p.corner_vertex[c] = reversed ? mesh.to_vertex_handle(h).idx() : from;
       corner_halfedge[c] = h.idx();
       link[c].face = f;
@@ -690,6 +694,18 @@ bool has_deleted_elements(const Mesh& mesh) {
   return (mesh.has_vertex_status() && any_deleted(mesh.vertex_status_pph())) ||
          (mesh.has_edge_status() && any_deleted(mesh.edge_status_pph())) ||
          (mesh.has_face_status() && any_deleted(mesh.face_status_pph()));
+}
+
+// Whether make_polytope may read `mesh` before it is validated: every coordinate is finite
+// (exact arithmetic needs finite values). Holds for every mesh that passes the check. An open
+// mesh needs no test: connectivity_from_halfedges counts the corners of the face cycles
+// (each halfedge is in at most one) and throws unless they cover every halfedge, before it
+// follows any link between faces; the cycle path throws on an edge with one facet.
+bool readable(const Mesh& mesh) {
+  const Point* q = mesh.points();
+  for (std::size_t v = 0; v < mesh.n_vertices(); ++v)
+    if (!std::isfinite(q[v][0]) || !std::isfinite(q[v][1]) || !std::isfinite(q[v][2])) return false;
+  return true;
 }
 
 }  // namespace
@@ -901,8 +917,40 @@ Polytope make_polytope(const Mesh& mesh, const char* name, FaceOrder order) {
 }
 
 Polytope make_operand(const Mesh& mesh, const char* name) {
-  const bool inverted = check_operand(mesh, name).has_value();
-  return make_polytope(mesh, name, inverted ? FaceOrder::reversed : FaceOrder::as_given);
+  // The polytope is built while the mesh is checked (on another thread when there is one),
+  // as if the mesh were valid and outward: its halfedges are read before the check has
+  // passed, which is safe once every coordinate is finite (all make_polytope's other
+  // assumptions, a closed mesh first, are tested as it goes, or only make it throw). The
+  // check's verdict decides: its error wins, an inverted mesh is built again reversed, and
+  // otherwise the build's result (or error) is the one the sequential order would give.
+  std::atomic<bool> rejected{false};
+  bool inverted = false, built = false;
+  Polytope p;
+  std::exception_ptr build_error;
+  // The build is the first function, which never throws (its error is kept), so the check's
+  // error is the one run_both rethrows. With one thread TBB runs the second function first:
+  // the check, so a rejected mesh is not built at all.
+  run_both(
+      [&] {
+        if (rejected || !readable(mesh)) return;
+        try {
+          p = make_polytope(mesh, name);
+          built = true;
+        } catch (...) {
+          build_error = std::current_exception();
+        }
+      },
+      [&] {
+        try {
+          inverted = check_operand(mesh, name).has_value();
+        } catch (...) {
+          rejected = true;
+          throw;
+        }
+      });
+  if (inverted) return make_polytope(mesh, name, FaceOrder::reversed);
+  if (build_error) std::rethrow_exception(build_error);
+  return built ? std::move(p) : make_polytope(mesh, name);
 }
 
 Operands make_operands(const Mesh& A, const Mesh& B) {

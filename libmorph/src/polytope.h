@@ -238,7 +238,8 @@ Polytope make_polytope(std::vector<V3<double>> points, ExactPoints exact_points,
                        std::vector<V3<ExactN>> given_normals, const char* name);
 
 /// An operand: checks `mesh` with prepare_convex_polyhedron (throwing invalid_mesh /
-/// not_convex prefixed with `name`, flipping a fully inverted mesh) and builds its polytope.
+/// not_convex prefixed with `name`, flipping a fully inverted mesh) and builds its polytope,
+/// the build beside the check when threads allow (same result and errors as in sequence).
 Polytope make_operand(const Mesh& mesh, const char* name);
 
 /// make_operand(A, "A") and make_operand(B, "B"), side by side when threads allow; A's

@@ -133,23 +133,30 @@ struct FaceCycles {
 FaceCycles face_cycles(const MeshView& m) {
   FaceCycles cycles;
   cycles.begin.resize(m.n_faces + 1);
-  cycles.vertex.reserve(m.n_halfedges);
-  cycles.across.reserve(m.n_halfedges);
+  // At most one corner per halfedge: written by index, trimmed at the end.
+  cycles.vertex.resize(m.n_halfedges);
+  cycles.across.resize(m.n_halfedges);
+  int* const vertex = cycles.vertex.data();
+  int* const across = cycles.across.data();
+  int c = 0;
   for (int f = 0; f < m.n_faces; ++f) {
-    cycles.begin[f] = static_cast<int>(cycles.vertex.size());
+    cycles.begin[f] = c;
     if (!m.live_face(f)) continue;
     const int first = m.halfedge_of_face(f);
     int h = first;
     do {
-      if (static_cast<int>(cycles.vertex.size()) == m.n_halfedges)
+      if (c == m.n_halfedges)
         throw error("internal error: mesh face " + std::to_string(f) +
                     " is not a closed cycle of halfedges");
-      cycles.vertex.push_back(m.to(h));
-      cycles.across.push_back(m.face(h ^ 1));
+      vertex[c] = m.to(h);
+      across[c] = m.face(h ^ 1);
+      ++c;
       h = m.next(h);
     } while (h != first);
   }
-  cycles.begin[m.n_faces] = static_cast<int>(cycles.vertex.size());
+  cycles.begin[m.n_faces] = c;
+  cycles.vertex.resize(c);
+  cycles.across.resize(c);
   return cycles;
 }
 
@@ -333,7 +340,15 @@ FacePlane unit_plane(const MeshView& m, const FaceCycles& cycles, int f) {
 bool reflex_across(const MeshView& m, const FaceCycles& cycles, const FacePlane& plane, int g,
                    int from, int to, double tolerance) {
   const int* corners = cycles.corners(g);
-  for (int k = 0; k < cycles.degree(g); ++k) {
+  const int n = cycles.degree(g);
+  if (n == 3) {  // the usual case: the one corner off the edge, found without a loop
+    const int v = corners[0] != from && corners[0] != to   ? corners[0]
+                  : corners[1] != from && corners[1] != to ? corners[1]
+                                                           : corners[2];
+    // A triangle that repeats a vertex fails its own check later, which then wins.
+    return !(height(plane, m.points[v]) <= tolerance);
+  }
+  for (int k = 0; k < n; ++k) {
     const int v = corners[k];
     if (v == from || v == to) continue;
     if (!(height(plane, m.points[v]) <= tolerance)) return true;
