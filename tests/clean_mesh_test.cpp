@@ -2,10 +2,13 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <array>
+#include <map>
 #include <set>
 #include <vector>
 
 #include "fims.h"
+#include "parallel.h"
 
 namespace {
 
@@ -56,6 +59,70 @@ TEST_CASE("clean_mesh merges a split facet and drops the vertices in the middle 
   // The top comes from its larger half; equal areas: the first.
   CHECK(std::count(source.begin(), source.end(), 0) == 1);
   CHECK(std::count(source.begin(), source.end(), 2) == 0);
+}
+
+// The unit cube with each face an n x n grid of quads whose inner points are off their
+// face's plane by less than the feature size: more facets, corners and points than one
+// chunk of each of clean_mesh's parallel loops. Every grid merges into one square.
+TEST_CASE("clean_mesh merges large grids of nearly coplanar facets alike with 1 and 2 threads") {
+  constexpr int n = 12;
+  std::vector<V3<double>> points;
+  std::map<std::array<int, 3>, int> index;  // grid point -> point
+  auto point = [&](std::array<int, 3> g, int axis) {
+    const auto [it, added] = index.emplace(g, static_cast<int>(points.size()));
+    if (added) {
+      V3<double> p{double(g[0]) / n, double(g[1]) / n, double(g[2]) / n};
+      // Inside a face: 1e-13 off its plane, alternately out and in (the limit is ~1.7e-11).
+      const bool inner = std::count(g.begin(), g.end(), 0) + std::count(g.begin(), g.end(), n) == 1;
+      const double off = inner ? ((g[0] + g[1] + g[2]) % 2 ? 1e-13 : -1e-13) : 0;
+      (axis == 0 ? p.x : axis == 1 ? p.y : p.z) += off;
+      points.push_back(p);
+    }
+    return it->second;
+  };
+  std::vector<int> begin{0}, corners;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side) {
+      const int u = (axis + 1) % 3, w = (axis + 2) % 3;  // (u, w, axis) is right-handed
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+          std::array<int, 3> q[4];
+          const int du[4] = {0, 1, 1, 0}, dw[4] = {0, 0, 1, 1};
+          for (int k = 0; k < 4; ++k) {
+            q[k][axis] = side * n;
+            q[k][u] = i + du[k];
+            q[k][w] = j + dw[k];
+          }
+          // Counter-clockwise about the outward normal: reversed on the low side.
+          for (int k = 0; k < 4; ++k) corners.push_back(point(q[side ? k : 3 - k], axis));
+          begin.push_back(static_cast<int>(corners.size()));
+        }
+    }
+  REQUIRE(begin.size() - 1 > 512);  // more than one chunk of facets (kFacetGrain)
+  std::vector<int> source1, source2;
+  const morph::Mesh one = morph::detail::run_with_threads(
+      1, [&] { return clean_mesh(points, begin, corners, &source1); });
+  const morph::Mesh two = morph::detail::run_with_threads(
+      2, [&] { return clean_mesh(points, begin, corners, &source2); });
+  CHECK(one.n_vertices() == 8);
+  REQUIRE(one.n_faces() == 6);
+  CHECK(one.n_edges() == 12);
+  for (auto f : one.faces()) CHECK(one.valence(f) == 4);
+  for (auto h : one.halfedges()) CHECK_FALSE(one.is_boundary(h));
+  for (auto v : one.vertices())
+    for (int axis = 0; axis < 3; ++axis)
+      CHECK((one.point(v)[axis] == 0 || one.point(v)[axis] == 1));
+  // The same mesh, element for element, with two threads.
+  CHECK(source1 == source2);
+  REQUIRE(two.n_vertices() == one.n_vertices());
+  REQUIRE(two.n_faces() == one.n_faces());
+  for (auto v : one.vertices()) CHECK(two.point(v) == one.point(v));
+  for (auto f : one.faces()) {
+    std::vector<int> a, b;
+    for (auto v : one.fv_range(f)) a.push_back(v.idx());
+    for (auto v : two.fv_range(morph::Mesh::FaceHandle(f.idx()))) b.push_back(v.idx());
+    CHECK(a == b);
+  }
 }
 
 }  // namespace

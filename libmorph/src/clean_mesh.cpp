@@ -20,6 +20,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -27,6 +28,7 @@
 #include <optional>
 
 #include "fims.h"
+#include "parallel.h"
 #include "union_find.h"
 
 namespace morph::detail {
@@ -53,6 +55,21 @@ struct Connectivity {
   std::vector<int> face, next, prev, twin;
 };
 
+// Chunk sizes of the parallel loops: large enough that a chunk pays for its task, small
+// enough that a result of a few thousand facets is split between two threads.
+constexpr int kFacetGrain = 512;
+constexpr int kCornerGrain = 2048;
+
+/// parallel_chunks, but a plain loop when the arena has one thread: each of these passes
+/// is short, and a TBB loop costs a few microseconds even with nothing to share.
+template <class Body>
+void parallel_pass(int n, int grain, const Body& body) {
+  if (tbb::this_task_arena::max_concurrency() > 1)
+    parallel_chunks(n, grain, body);
+  else if (n > 0)
+    body(0, n);
+}
+
 /// The facet, next and previous corner of every corner (no twins yet).
 Connectivity facet_cycles(const Soup& soup) {
   const int nc = static_cast<int>(soup.vertex.size());
@@ -60,14 +77,19 @@ Connectivity facet_cycles(const Soup& soup) {
   k.face.resize(nc);
   k.next.resize(nc);
   k.prev.resize(nc);
-  for (int f = 0; f < soup.size(); ++f) {
-    const int b = soup.begin[f], e = soup.begin[f + 1];
-    for (int c = b; c < e; ++c) {
-      k.face[c] = f;
-      k.next[c] = c + 1 == e ? b : c + 1;
-      k.prev[c] = c == b ? e - 1 : c - 1;
+  parallel_pass(soup.size(), kFacetGrain, [&](int first, int last) {
+    for (int f = first; f < last; ++f) {
+      const int b = soup.begin[f], e = soup.begin[f + 1];
+      if (b == e) continue;
+      for (int c = b; c < e; ++c) {
+        k.face[c] = f;
+        k.next[c] = c + 1;
+        k.prev[c] = c - 1;
+      }
+      k.next[e - 1] = b;
+      k.prev[b] = e - 1;
     }
-  }
+  });
   return k;
 }
 
@@ -229,7 +251,9 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
                     bool& changed) {
   const int nf = soup.size();
   std::vector<FacetGeometry> geo(nf);
-  for (int f = 0; f < nf; ++f) geo[f] = geometry(points, soup, f);
+  parallel_pass(nf, kFacetGrain, [&](int first, int last) {
+    for (int f = first; f < last; ++f) geo[f] = geometry(points, soup, f);
+  });
   const Groups groups = group_coplanar(points, soup, k, geo, limit);
   if (strict)
     for (int f = 0; f < nf; ++f)
@@ -241,7 +265,9 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
       }
   const int nc = static_cast<int>(soup.vertex.size());
   std::vector<int> corner_group(nc);  // looked up several times per corner below
-  for (int c = 0; c < nc; ++c) corner_group[c] = groups.of[k.face[c]];
+  parallel_pass(nc, kCornerGrain, [&](int first, int last) {
+    for (int c = first; c < last; ++c) corner_group[c] = groups.of[k.face[c]];
+  });
   const auto group = [&](int c) { return corner_group[c]; };
   // Vertices keep their place when at least three groups meet there.
   std::vector<char> keep(points.size(), 0), seen(points.size(), 0);
@@ -331,12 +357,22 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
     }
     const int d = size - first;
     if (before_first >= 0 && d > 0) chain_end[size - 1] = before_first;  // the chain wraps
-    if (d < 3 ||
-        !convex_polygon(points, out.vertex.data() + first, d, geo[largest[g]].normal, limit))
-      return false;
+    if (d < 3) return false;
     out.begin.push_back(size);
     out.source.push_back(soup.source[largest[g]]);
   }
+  // Each polygon's corner test, against the plane of its group's largest facet (the group
+  // of the corners its chains cover): independent, so in parallel, after the walks.
+  std::atomic<bool> convex{true};
+  parallel_pass(out.size(), kFacetGrain, [&](int first, int last) {
+    for (int m = first; m < last && convex.load(std::memory_order_relaxed); ++m) {
+      const int b = out.begin[m];
+      const V3<double>& normal = geo[largest[group(chain_end[b])]].normal;
+      if (!convex_polygon(points, out.vertex.data() + b, out.degree(m), normal, limit))
+        convex.store(false, std::memory_order_relaxed);
+    }
+  });
+  if (!convex.load()) return false;
   out.vertex.resize(size);
   merged_twin.resize(size);
   for (int m = 0; m < size; ++m) merged_twin[m] = chain_of[k.twin[chain_end[m]]];
@@ -354,14 +390,20 @@ std::optional<Connectivity> connect_with(int num_points, const Soup& soup,
   const int nc = static_cast<int>(soup.vertex.size());
   Connectivity k = facet_cycles(soup);
   k.twin = std::move(twin);
+  std::atomic<bool> reverse{true};
+  parallel_pass(nc, kCornerGrain, [&](int first, int last) {
+    for (int c = first; c < last; ++c) {
+      const int t = k.twin[c];
+      if (t < 0 || t >= nc || t == c || k.twin[t] != c ||
+          soup.vertex[t] != soup.vertex[k.next[c]] || soup.vertex[k.next[t]] != soup.vertex[c]) {
+        reverse.store(false, std::memory_order_relaxed);
+        return;
+      }
+    }
+  });
+  if (!reverse.load()) return std::nullopt;
   std::vector<int> out_count(num_points, 0), mark(num_points, -1);
-  for (int c = 0; c < nc; ++c) {
-    const int t = k.twin[c];
-    if (t < 0 || t >= nc || t == c || k.twin[t] != c || soup.vertex[t] != soup.vertex[k.next[c]] ||
-        soup.vertex[k.next[t]] != soup.vertex[c])
-      return std::nullopt;
-    ++out_count[soup.vertex[c]];
-  }
+  for (int c = 0; c < nc; ++c) ++out_count[soup.vertex[c]];
   for (int s = 0; s < nc; ++s) {
     const int v = soup.vertex[s];
     if (out_count[v] < 0) continue;  // its fan is checked
@@ -422,8 +464,10 @@ Mesh build(const std::vector<V3<double>>& points, const Soup& soup, const Connec
   // Every element at once: OpenMesh grows each of its property arrays per added element.
   // The elements are numbered as add_vertex, new_edge and new_face would number them.
   mesh.resize(num_used, num_edges, soup.size());
+  // The point array, looked up once (set_point looks its property up by a dynamic_cast).
+  Point* point = mesh.property(mesh.points_pph()).data_vector().data();
   for (std::size_t v = 0; v < points.size(); ++v)
-    if (used[v]) mesh.set_point(handle[v], Point(points[v].x, points[v].y, points[v].z));
+    if (used[v]) point[handle[v].idx()] = Point(points[v].x, points[v].y, points[v].z);
   std::vector<Mesh::HalfedgeHandle> he(nc);
   int edge = 0;
   for (int c = 0; c < nc; ++c) {
@@ -436,16 +480,20 @@ Mesh build(const std::vector<V3<double>>& points, const Soup& soup, const Connec
       mesh.set_vertex_handle(mesh.opposite_halfedge_handle(he[c]), handle[soup.vertex[c]]);
     }
   }
-  for (int f = 0; f < soup.size(); ++f) {
-    const Mesh::FaceHandle fh(f);
-    const int b = soup.begin[f], e = soup.begin[f + 1];
-    for (int c = b; c < e; ++c) {
-      mesh.set_face_handle(he[c], fh);
-      mesh.set_next_halfedge_handle(he[c], he[k.next[c]]);
-      mesh.set_halfedge_handle(handle[soup.vertex[c]], he[c]);
+  // Faces write their own halfedges only: in parallel.
+  parallel_pass(soup.size(), kFacetGrain, [&](int first, int last) {
+    for (int f = first; f < last; ++f) {
+      const Mesh::FaceHandle fh(f);
+      const int b = soup.begin[f], e = soup.begin[f + 1];
+      for (int c = b; c < e; ++c) {
+        mesh.set_face_handle(he[c], fh);
+        mesh.set_next_halfedge_handle(he[c], he[k.next[c]]);
+      }
+      mesh.set_halfedge_handle(fh, he[e - 1]);  // as add_face: the cycle starts at vertex b
     }
-    mesh.set_halfedge_handle(fh, he[e - 1]);  // as add_face: the cycle starts at vertex b
-  }
+  });
+  // A vertex's halfedge is its last corner's (as when faces are added in order).
+  for (int c = 0; c < nc; ++c) mesh.set_halfedge_handle(handle[soup.vertex[c]], he[c]);
   return mesh;
 }
 
@@ -578,41 +626,78 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
   const double far = limit_squared >= std::numeric_limits<double>::min()
                          ? 2 * limit_squared
                          : std::numeric_limits<double>::infinity();
-  auto merge_if_close = [&](int u, int w) {
+  auto close = [&](int u, int w) {
     const V3<double> d = points[u] - points[w];
     const double distance_squared = dot(d, d);
-    if (distance_squared <= far && std::sqrt(distance_squared) <= limit) {
-      clusters.unite(u, w);
-    }
+    return distance_squared <= far && std::sqrt(distance_squared) <= limit;
   };
-  for (int f = 0; f < nf; ++f) {
+  // Calls pair(u, w) on the corners of facet f that are compared.
+  auto for_pairs = [&](int f, const auto& pair) {
     const int b = face_begin[f], e = face_begin[f + 1];
     if (e - b <= kPairwiseDegree) {  // also across a facet: the diagonal of a thin parallelogram
       for (int c = b; c < e; ++c)
-        for (int d = c + 1; d < e; ++d) merge_if_close(corners[c], corners[d]);
+        for (int d = c + 1; d < e; ++d) pair(corners[c], corners[d]);
     } else {
-      for (int c = b; c < e; ++c) merge_if_close(corners[c], corners[c + 1 == e ? b : c + 1]);
+      for (int c = b; c < e; ++c) pair(corners[c], corners[c + 1 == e ? b : c + 1]);
+    }
+  };
+  // The facets with close corners (few), found in parallel; their unions follow in order.
+  std::vector<char> has_close(nf, 0);
+  std::atomic<bool> any_close{false};
+  parallel_pass(nf, kFacetGrain, [&](int first, int last) {
+    bool found = false;
+    for (int f = first; f < last; ++f) {
+      bool here = false;
+      for_pairs(f, [&](int u, int w) { here = here || close(u, w); });
+      has_close[f] = here;
+      found = found || here;
+    }
+    if (found) any_close.store(true, std::memory_order_relaxed);
+  });
+  if (any_close.load())
+    for (int f = 0; f < nf; ++f)
+      if (has_close[f])
+        for_pairs(f, [&](int u, int w) {
+          if (close(u, w)) clusters.unite(u, w);
+        });
+  Soup soup;
+  bool repeated = false;
+  std::vector<int> last_facet(n, -1);  // the last facet a point was seen in, to find repeats
+  // Nothing merged (the usual case): the facets are the soup as they are, unless one has a
+  // repeated corner or fewer than three.
+  bool as_given = !any_close.load();
+  for (int f = 0; f < nf && as_given; ++f) {
+    const int b = face_begin[f], e = face_begin[f + 1];
+    as_given = e - b >= 3;
+    for (int c = b; c < e && as_given; ++c) {
+      as_given = last_facet[corners[c]] != f;
+      last_facet[corners[c]] = f;
     }
   }
-  Soup soup;
-  soup.vertex.reserve(corners.size());
-  soup.source.reserve(nf);
-  bool repeated = false;
-  std::vector<int> cycle;
-  std::vector<int> last_facet(n, -1);  // the last facet a point was seen in, to find repeats
-  for (int f = 0; f < nf; ++f) {
-    cycle.clear();
-    for (int c = face_begin[f]; c < face_begin[f + 1]; ++c) {
-      const int v = clusters.find(corners[c]);
-      if (cycle.empty() || cycle.back() != v) cycle.push_back(v);
+  if (as_given) {
+    soup.begin = face_begin;
+    soup.vertex = corners;
+    soup.source.resize(nf);
+    std::iota(soup.source.begin(), soup.source.end(), 0);
+  } else {
+    std::fill(last_facet.begin(), last_facet.end(), -1);
+    soup.vertex.reserve(corners.size());
+    soup.source.reserve(nf);
+    std::vector<int> cycle;
+    for (int f = 0; f < nf; ++f) {
+      cycle.clear();
+      for (int c = face_begin[f]; c < face_begin[f + 1]; ++c) {
+        const int v = clusters.find(corners[c]);
+        if (cycle.empty() || cycle.back() != v) cycle.push_back(v);
+      }
+      while (cycle.size() > 1 && cycle.front() == cycle.back()) cycle.pop_back();
+      if (cycle.size() < 3) continue;  // collapsed onto an edge or a point: its neighbours meet
+      for (std::size_t i = 0; i < cycle.size() && !repeated; ++i) {
+        repeated = last_facet[cycle[i]] == f;
+        last_facet[cycle[i]] = f;
+      }
+      soup.add(cycle, f);
     }
-    while (cycle.size() > 1 && cycle.front() == cycle.back()) cycle.pop_back();
-    if (cycle.size() < 3) continue;  // collapsed onto an edge or a point: its neighbours meet
-    for (std::size_t i = 0; i < cycle.size() && !repeated; ++i) {
-      repeated = last_facet[cycle[i]] == f;
-      last_facet[cycle[i]] = f;
-    }
-    soup.add(cycle, f);
   }
   std::optional<std::pair<Soup, Connectivity>> result;
   if (!repeated) result = simplify(points, soup, limit, true);
