@@ -70,71 +70,27 @@ V3<Interval> to_interval_n(const V3<ExactN>& p) {
 /// Runs of the incremental hull, each with a reach 2^20 times larger, before the exact route.
 constexpr int kReachAttempts = 3;
 
-/// Relative error of each component of a precise plane (see Plane::precise).
-constexpr double kPlaneRelative = 0x1p-100;
-
 /// A half-space as the homogeneous plane <n, x> <= d (the HalfSpace times its
-/// denominator, so both are dyadic), with interval copies for the filters and a precise
-/// copy for the second stage.
+/// denominator, so both are dyadic), with interval copies for the filters.
 struct Plane {
   V3<ExactN> n;
   ExactN d;
   V3<Interval> ni;
   Interval di;
-  // n.x, n.y, n.z, d times a power of two (any positive factor leaves every sign and every
-  // meet unchanged) in double-double, each within kPlaneRelative of |hi| of the exact
-  // value; the largest normal component in [1, 2), |d| <= 2^400 and every non-zero
-  // component above 2^-900, so the precise stages neither overflow nor lose a component.
-  // Only when `precise`.
-  std::array<DD, 4> p{};
-  bool precise = false;
 };
-
-/// Four exact values in double-double, each within kPlaneRelative of |hi|, all scaled by
-/// the power of two that brings the largest |c[k]|, k in [lead_begin, lead_end), into
-/// [1, 2); false when a value is beyond 2^400 or a non-zero one below 2^-900 after that
-/// (round-to-nearest).
-bool precise_scaled(const std::array<const ExactN*, 4>& c, int lead_begin, int lead_end,
-                    std::array<DD, 4>& out) {
-  std::array<DD, 4> v{};
-  double largest = 0;
-  for (int k = 0; k < 4; ++k) {
-    if (CGAL::sign(*c[k]) == CGAL::ZERO) continue;
-    double error;
-    v[k] = to_dd(*c[k], error);
-    // Half the allowed error: scaling may round a subnormal lo (by 2^-1075 at most).
-    if (!(error <= kPlaneRelative / 2 * std::abs(v[k].hi))) return false;
-    if (k >= lead_begin && k < lead_end) largest = std::max(largest, std::abs(v[k].hi));
-  }
-  if (!(largest > 0)) return false;
-  const int shift = -std::ilogb(largest);
-  for (int k = 0; k < 4; ++k) {
-    if (v[k].hi == 0) continue;
-    v[k] = {std::ldexp(v[k].hi, shift), std::ldexp(v[k].lo, shift)};
-    if (!(std::abs(v[k].hi) >= 0x1p-900 && std::abs(v[k].hi) <= 0x1p400)) return false;
-  }
-  out = v;
-  return true;
-}
-
-/// The precise copy of a plane (see Plane::p); left out when out of range.
-void make_precise(Plane& plane) {
-  plane.precise = precise_scaled({&plane.n.x, &plane.n.y, &plane.n.z, &plane.d}, 0, 3, plane.p);
-}
 
 std::vector<Plane> planes_of(const std::vector<HalfSpace>& hs) {
   std::vector<Plane> planes(hs.size());
   parallel_chunks(static_cast<int>(hs.size()), 256, [&](int begin, int end) {
-    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);  // for make_precise
+    RoundingGuard guard;
     for (int i = begin; i < end; ++i) {
       Plane& p = planes[i];
       const ExactN& q = hs[i].denominator;
       p.n = q == 1 ? hs[i].normal
                    : V3<ExactN>{hs[i].normal.x * q, hs[i].normal.y * q, hs[i].normal.z * q};
       p.d = hs[i].offset;
-      p.ni = to_interval_n(p.n);  // Mpzf's enclosures do not depend on the rounding mode
+      p.ni = to_interval_n(p.n);
       p.di = to_interval_n(p.d);
-      make_precise(p);
     }
   });
   return planes;
@@ -236,6 +192,7 @@ struct HVertex {
   V3<double> ex{};
   double ew = 0;
   bool precise = false;
+  bool doubles = false;  // a known point X / 1 with X exactly doubles: its rounding is X
 };
 
 /// The point of three planes (Cramer's rule); W = det(n_a, n_b, n_c).
@@ -309,16 +266,66 @@ struct Magnitude {
 };
 Magnitude magnitude(const DD& x) { return {std::abs(x.hi)}; }
 V3<Magnitude> magnitude(const V3<DD>& p) { return {magnitude(p.x), magnitude(p.y), magnitude(p.z)}; }
-V3<DD> normal_dd(const Plane& p) { return {p.p[0], p.p[1], p.p[2]}; }
-V3<Magnitude> normal_magnitude(const Plane& p) { return magnitude(normal_dd(p)); }
 
 constexpr double kEvaluation = 32 * kU2;  // (b)
 
+/// Relative error of each component of a precise plane (a).
+constexpr double kPlaneRelative = 0x1p-100;
+
+/// Four exact values in double-double, each within kPlaneRelative of |hi|, all scaled by
+/// the power of two that brings the largest |c[k]|, k in [lead_begin, lead_end), into
+/// [1, 2); false when a value is beyond 2^400 or a non-zero one below 2^-900 after that
+/// (round-to-nearest).
+bool precise_scaled(const std::array<const ExactN*, 4>& c, int lead_begin, int lead_end,
+                    std::array<DD, 4>& out) {
+  std::array<DD, 4> v{};
+  double largest = 0;
+  for (int k = 0; k < 4; ++k) {
+    if (CGAL::sign(*c[k]) == CGAL::ZERO) continue;
+    double error;
+    v[k] = to_dd(*c[k], error);
+    // Half the allowed error: scaling may round a subnormal lo (by 2^-1075 at most).
+    if (!(error <= kPlaneRelative / 2 * std::abs(v[k].hi))) return false;
+    if (k >= lead_begin && k < lead_end) largest = std::max(largest, std::abs(v[k].hi));
+  }
+  if (!(largest >= 0x1p-1000 && largest < 0x1p1000)) return false;
+  const double scale = std::ldexp(1.0, -std::ilogb(largest));  // exact products
+  for (int k = 0; k < 4; ++k) {
+    if (v[k].hi == 0) continue;
+    v[k] = {v[k].hi * scale, v[k].lo * scale};
+    if (!(std::abs(v[k].hi) >= 0x1p-900 && std::abs(v[k].hi) <= 0x1p400)) return false;
+  }
+  out = v;
+  return true;
+}
+
+/// A plane's n.x, n.y, n.z, d times a power of two (any positive factor leaves every sign
+/// and every meet unchanged) in double-double: precise_scaled with the largest normal
+/// component in [1, 2), so |d| <= 2^400 and every non-zero component is above 2^-900 (the
+/// precise stage neither overflows nor loses a component). Not `valid` out of that range.
+struct PrecisePlane {
+  std::array<DD, 4> c{};
+  bool valid = false;
+};
+PrecisePlane precise_plane(const Plane& plane) {
+  PrecisePlane p;
+  p.valid = precise_scaled({&plane.n.x, &plane.n.y, &plane.n.z, &plane.d}, 0, 3, p.c);
+  return p;
+}
+V3<DD> normal_dd(const PrecisePlane& p) { return {p.c[0], p.c[1], p.c[2]}; }
+V3<Magnitude> normal_magnitude(const PrecisePlane& p) { return magnitude(normal_dd(p)); }
+
 /// The precise coordinates of a vertex (round-to-nearest): a known point's from its exact
 /// ones (W in [1, 2)), another's as the meet of its precise planes. Left out when a plane
-/// is not precise or a value out of range.
-void make_precise(const std::vector<Plane>& planes, HVertex& v) {
+/// is not valid or a value out of range.
+void make_precise(const std::vector<PrecisePlane>& planes, HVertex& v) {
   if (v.known >= 0) {
+    const auto is_double = [](const ExactN& x) {
+      const double d = x.to_double();
+      return std::isfinite(d) && x == ExactN(d);
+    };
+    v.doubles = v.W.is_one() && is_double(v.X.x) && is_double(v.X.y) && is_double(v.X.z);
+    if (v.doubles) return;  // (a closing's vertices, A's own)
     std::array<DD, 4> c;
     if (!precise_scaled({&v.X.x, &v.X.y, &v.X.z, &v.W}, 3, 4, c)) return;
     v.px = {c[0], c[1], c[2]};
@@ -329,30 +336,31 @@ void make_precise(const std::vector<Plane>& planes, HVertex& v) {
     v.precise = true;
     return;
   }
-  const Plane &a = planes[v.planes[0]], &b = planes[v.planes[1]], &c = planes[v.planes[2]];
-  if (!a.precise || !b.precise || !c.precise) return;
-  meet(normal_dd(a), a.p[3], normal_dd(b), b.p[3], normal_dd(c), c.p[3], v.px, v.pw);
+  const PrecisePlane &a = planes[v.planes[0]], &b = planes[v.planes[1]],
+                     &c = planes[v.planes[2]];
+  if (!a.valid || !b.valid || !c.valid) return;
+  meet(normal_dd(a), a.c[3], normal_dd(b), b.c[3], normal_dd(c), c.c[3], v.px, v.pw);
   V3<Magnitude> mx;
   Magnitude mw;
-  meet(normal_magnitude(a), magnitude(a.p[3]), normal_magnitude(b), magnitude(b.p[3]),
-       normal_magnitude(c), magnitude(c.p[3]), mx, mw);
+  meet(normal_magnitude(a), magnitude(a.c[3]), normal_magnitude(b), magnitude(b.c[3]),
+       normal_magnitude(c), magnitude(c.c[3]), mx, mw);
   // Degree 3 in the planes' components; underflow in the cross products is multiplied by
   // at most |d| (no overflow: |n| < 2, |d| <= 2^400).
   constexpr double factor = (3 * kPlaneRelative + kEvaluation) * 1.01;
   const double absolute =
-      0x1p-960 * (1 + std::abs(a.p[3].hi) + std::abs(b.p[3].hi) + std::abs(c.p[3].hi));
+      0x1p-960 * (1 + std::abs(a.c[3].hi) + std::abs(b.c[3].hi) + std::abs(c.c[3].hi));
   v.ex = {factor * mx.x.v + absolute, factor * mx.y.v + absolute, factor * mx.z.v + absolute};
   v.ew = factor * mw.v + 0x1p-960;
   v.precise = true;
 }
 
 /// Sign of <n, X> - d W from the precise stage, or 2 (round-to-nearest; both precise).
-int precise_side(const Plane& p, const HVertex& v) {
-  const DD value = dot(normal_dd(p), v.px) - p.p[3] * v.pw;
+int precise_side(const PrecisePlane& p, const HVertex& v) {
+  const DD value = dot(normal_dd(p), v.px) - p.c[3] * v.pw;
   const V3<Magnitude> n = normal_magnitude(p);
-  const Magnitude m = dot(n, magnitude(v.px)) - magnitude(p.p[3]) * magnitude(v.pw);
+  const Magnitude m = dot(n, magnitude(v.px)) - magnitude(p.c[3]) * magnitude(v.pw);
   const double moved = n.x.v * v.ex.x + n.y.v * v.ex.y + n.z.v * v.ex.z +
-                       std::abs(p.p[3].hi) * v.ew;  // by the vertex's errors
+                       std::abs(p.c[3].hi) * v.ew;  // by the vertex's errors
   const double bound = ((kPlaneRelative + kEvaluation) * m.v + moved) * 1.01 + 0x1p-1000;
   if (value.hi > bound) return 1;
   if (value.hi < -bound) return -1;
@@ -361,7 +369,7 @@ int precise_side(const Plane& p, const HVertex& v) {
 
 /// Sign of <n, Xu> Wv - <n, Xv> Wu from the precise stage, or 2 (round-to-nearest; all
 /// precise). Each vertex's own factor is positive, so the sign is that of <n, u - v>.
-int precise_compare(const Plane& p, const HVertex& u, const HVertex& v) {
+int precise_compare(const PrecisePlane& p, const HVertex& u, const HVertex& v) {
   const V3<DD> n = normal_dd(p);
   const DD value = dot(n, u.px) * v.pw - dot(n, v.px) * u.pw;
   const V3<Magnitude> nm = normal_magnitude(p);
@@ -379,32 +387,56 @@ int precise_compare(const Plane& p, const HVertex& u, const HVertex& v) {
   return 2;
 }
 
+/// A plane's precise copy, made when a filter first needs it (by the one thread that
+/// tests that plane).
+class LazyPrecisePlane {
+ public:
+  explicit LazyPrecisePlane(const Plane& plane) : plane_(plane) {}
+  const PrecisePlane& get() {  // round-to-nearest
+    if (!made_) precise_ = precise_plane(plane_);
+    made_ = true;
+    return precise_;
+  }
+
+ private:
+  const Plane& plane_;
+  PrecisePlane precise_;
+  bool made_ = false;
+};
+
 /// Sign of <n, x> - d at a vertex from the filters alone (intervals, then the precise
-/// stage in round-to-nearest), or 2: > 0 when the vertex violates the half-space.
-int side_filter(const Plane& p, const HVertex& v) {
+/// stage in round-to-nearest), or 2: > 0 when the vertex violates the half-space. A known
+/// point skips the precise stage: its exact coordinates are there, and small (in a closing
+/// the undecided tests are mostly exact zeros, planes touching the result).
+int side_filter(const Plane& p, LazyPrecisePlane& precise, const HVertex& v) {
   const int s = interval_sign(dot(p.ni, v.Xi) - p.di * v.Wi);
-  if (s != 2 || !p.precise || !v.precise) return s;
+  if (s != 2 || !v.precise || v.known >= 0) return s;
   CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
-  return precise_side(p, v);
+  const PrecisePlane& q = precise.get();
+  return q.valid ? precise_side(q, v) : 2;
 }
 int side_exact(const Plane& p, const HVertex& v) {
   return CGAL::sign(dot(p.n, v.X) - p.d * v.W);
 }
 
-/// Sign of <n, x> - d at a vertex, its exact coordinates computed when the filters fail.
+/// Sign of <n, x> - d at a vertex, its exact coordinates computed when the filter fails
+/// (the vertices are not precise yet where this is used).
 int side(const std::vector<Plane>& planes, const Plane& p, HVertex& v) {
-  const int s = side_filter(p, v);
+  const int s = interval_sign(dot(p.ni, v.Xi) - p.di * v.Wi);
   if (s != 2) return s;
   make_exact(planes, v);
   return side_exact(p, v);
 }
 
-/// Sign of <n, u> - <n, v> from the filters alone, or 2.
-int compare_filter(const Plane& p, const HVertex& u, const HVertex& v) {
+/// Sign of <n, u> - <n, v> from the filters alone, or 2 (two known points skip the
+/// precise stage, as in side_filter).
+int compare_filter(const Plane& p, LazyPrecisePlane& precise, const HVertex& u,
+                   const HVertex& v) {
   const int s = interval_sign(dot(p.ni, u.xi) - dot(p.ni, v.xi));
-  if (s != 2 || !p.precise || !u.precise || !v.precise) return s;
+  if (s != 2 || !u.precise || !v.precise || (u.known >= 0 && v.known >= 0)) return s;
   CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
-  return precise_compare(p, u, v);
+  const PrecisePlane& q = precise.get();
+  return q.valid ? precise_compare(q, u, v) : 2;
 }
 int compare_exact(const Plane& p, const HVertex& u, const HVertex& v) {
   return CGAL::sign(dot(p.n, u.X) * v.W - dot(p.n, v.X) * u.W);
@@ -673,16 +705,29 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   // Precise vertices, for the checks below (a second filter stage) and the rounding; exact
   // ones only where those cannot decide (LazyExact), but all of them for a polytope that is
   // computed with further.
+  // The planes of vertices that are not known points are made precise up front; the
+  // others when the walk below first needs them.
+  std::vector<PrecisePlane> precise(n);
+  {
+    std::vector<char> used(n, 0);
+    for (const HVertex& v : vertex)
+      if (v.known < 0) used[v.planes[0]] = used[v.planes[1]] = used[v.planes[2]] = 1;
+    parallel_chunks(n, 256, [&](int begin, int end) {
+      CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+      for (int i = begin; i < end; ++i)
+        if (used[i]) precise[i] = precise_plane(planes[i]);
+    });
+  }
   parallel_chunks(nv, 128, [&](int begin, int end) {
     CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
     for (int v = begin; v < end; ++v) {
-      make_precise(planes, vertex[v]);
+      make_precise(precise, vertex[v]);
       if (with_polytope) make_exact(planes, vertex[v]);
     }
   });
   LazyExact exact_vertex(planes, vertex);
-  const auto side_of = [&](const Plane& p, int v) {
-    const int s = side_filter(p, vertex[v]);
+  const auto side_of = [&](const Plane& p, LazyPrecisePlane& q, int v) {
+    const int s = side_filter(p, q, vertex[v]);
     return s != 2 ? s : side_exact(p, exact_vertex(v));
   };
   // The candidate is a convex polytope. Every plane that is not a dual vertex must not cut
@@ -697,10 +742,11 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     int u = 0;
     for (int j = begin; j < end && ok; ++j) {
       const Plane& p = planes[others[j]];
+      LazyPrecisePlane precise_p(p);
       for (bool moved = true; moved;) {
         moved = false;
         for (int a = adj_begin[u]; a < adj_begin[u + 1]; ++a) {
-          int s = compare_filter(p, vertex[adj[a]], vertex[u]);
+          int s = compare_filter(p, precise_p, vertex[adj[a]], vertex[u]);
           if (s == 2) s = compare_exact(p, exact_vertex(adj[a]), exact_vertex(u));
           if (s > 0) {
             u = adj[a];
@@ -709,7 +755,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
           }
         }
       }
-      const int sd = known_through(known, others[j], vertex[u]) ? 0 : side_of(p, u);
+      const int sd = known_through(known, others[j], vertex[u]) ? 0 : side_of(p, precise_p, u);
       if (sd > 0) ok = false;
       if (sd != 0) continue;
       std::vector<int>& plateau = touched[j];
@@ -717,7 +763,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       for (std::size_t q = 0; q < plateau.size(); ++q)
         for (int a = adj_begin[plateau[q]]; a < adj_begin[plateau[q] + 1]; ++a)
           if (std::find(plateau.begin(), plateau.end(), adj[a]) == plateau.end() &&
-              (known_through(known, others[j], vertex[adj[a]]) || side_of(p, adj[a]) == 0))
+              (known_through(known, others[j], vertex[adj[a]]) || side_of(p, precise_p, adj[a]) == 0))
             plateau.push_back(adj[a]);
       std::sort(plateau.begin(), plateau.end());
     }
@@ -788,6 +834,10 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       const HVertex& v = vertex[order[r]];
       double rounded[3];
       for (int i = 0; i < 3; ++i) {
+        if (v.doubles) {
+          rounded[i] = coordinate(v.X, i).to_double();
+          continue;
+        }
         if (v.precise &&
             round_precise(coordinate(v.px, i), coordinate(v.ex, i), v.pw, v.ew, rounded[i]))
           continue;
@@ -1073,6 +1123,10 @@ DualSurface exact_dual_hull(const std::vector<Plane>& planes, const V3<Exact>& o
 namespace {
 
 void probe_rounding(const HVertex& v, PreciseProbe& out) {
+  if (v.doubles) {
+    out.rounded = {v.X.x.to_double(), v.X.y.to_double(), v.X.z.to_double()};
+    out.decided = {true, true, true};
+  }
   if (!v.precise) return;
   out.decided = {round_precise(v.px.x, v.ex.x, v.pw, v.ew, out.rounded.x),
                  round_precise(v.px.y, v.ex.y, v.pw, v.ew, out.rounded.y),
@@ -1084,18 +1138,20 @@ void probe_rounding(const HVertex& v, PreciseProbe& out) {
 PreciseProbe probe_precise(const std::vector<HalfSpace>& hs) {
   const std::vector<Plane> planes = planes_of(hs);
   CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+  std::vector<PrecisePlane> precise;
+  for (const Plane& p : planes) precise.push_back(precise_plane(p));
   PreciseProbe out;
   HVertex u;
   u.planes = {0, 1, 2};
-  make_precise(planes, u);
+  make_precise(precise, u);
   probe_rounding(u, out);
-  if (hs.size() < 4 || !u.precise || !planes[3].precise) return out;
-  out.side = precise_side(planes[3], u);
+  if (hs.size() < 4 || !u.precise || !precise[3].valid) return out;
+  out.side = precise_side(precise[3], u);
   if (hs.size() < 7) return out;
   HVertex v;
   v.planes = {4, 5, 6};
-  make_precise(planes, v);
-  if (v.precise) out.compare = precise_compare(planes[3], u, v);
+  make_precise(precise, v);
+  if (v.precise) out.compare = precise_compare(precise[3], u, v);
   return out;
 }
 
