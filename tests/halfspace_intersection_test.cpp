@@ -321,8 +321,8 @@ bool same_double(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0
 
 /// The half-space <n, x> <= <n, p> (its plane through p), its normal scaled by 2^scale.
 HalfSpace plane_through(const V3<double>& n, const V3<ExactN>& p, int scale) {
-  const V3<ExactN> m = to_exact_n({std::ldexp(n.x, scale), std::ldexp(n.y, scale),
-                                   std::ldexp(n.z, scale)});
+  const V3<ExactN> m =
+      to_exact_n({std::ldexp(n.x, scale), std::ldexp(n.y, scale), std::ldexp(n.z, scale)});
   return {m, dot(m, p), ExactN(1), 0, -1};
 }
 
@@ -351,7 +351,7 @@ std::vector<NearTie> adversarial_points() {
         const double x = std::ldexp(bases[(k + 2 * i + s / 100 + 7) % 7], s);
         const double ulp = std::nextafter(x, HUGE_VAL) - x;
         ExactN v = ExactN(x);
-        if (k >= 1) v = v + ExactN(ulp / 2);                         // the midpoint
+        if (k >= 1) v = v + ExactN(ulp / 2);                            // the midpoint
         if (k > 1) v = v + ExactN(std::ldexp(ulp, -k) * (i ? 1 : -1));  // just off it
         *c[i] = v;
       }
@@ -368,8 +368,8 @@ std::vector<NearTie> adversarial_points() {
 // of one it must decline, and what it decides must be the exact rounding (ties to even),
 // also for nearly parallel planes, normals scaled by 2^+-200 and points far from the origin.
 TEST_CASE("halfspace_intersection: the precise stage rounds vertices as the exact rounding") {
-  const std::vector<V3<double>> normals = {{1, 0.25, -0.5}, {-0.3, 1, 0.1},   {0.2, -0.7, 1},
-                                           {0.6, 0.8, 0},   {0.577, 0.577, 0.578}};
+  const std::vector<V3<double>> normals = {
+      {1, 0.25, -0.5}, {-0.3, 1, 0.1}, {0.2, -0.7, 1}, {0.6, 0.8, 0}, {0.577, 0.577, 0.578}};
   int decided = 0, total = 0, far_from_ties = 0, far_decided = 0;
   for (const auto& [p, k] : adversarial_points()) {
     for (int scale : {0, -200, 200}) {
@@ -391,10 +391,11 @@ TEST_CASE("halfspace_intersection: the precise stage rounds vertices as the exac
           }
           // Far from a tie relative to the vertex's size (its largest coordinate): the
           // error bound is about 2^-95 of that for these well-conditioned normals.
-          const double largest = std::max({std::abs(p.x.to_double()), std::abs(p.y.to_double()),
-                                           std::abs(p.z.to_double())});
+          const double largest = std::max(
+              {std::abs(p.x.to_double()), std::abs(p.y.to_double()), std::abs(p.z.to_double())});
           for (int i = 0; i < 3; ++i) {
-            const double x = c[i]->to_double(), ulp = std::nextafter(std::abs(x), HUGE_VAL) - std::abs(x);
+            const double x = c[i]->to_double(),
+                         ulp = std::nextafter(std::abs(x), HUGE_VAL) - std::abs(x);
             const double distance = k == 0 ? ulp / 2 : std::ldexp(ulp, -k);
             if (tilt == 0 && k != 1 && distance >= 0x1p-80 * largest)
               far_from_ties++, far_decided += probe.decided[i];
@@ -445,8 +446,8 @@ TEST_CASE("halfspace_intersection: the precise side and compare signs are exact"
           hs.push_back(h);
           // v: p moved along the fourth plane's normal times 2^-bits of p's size (the
           // sign of <n, u - v> is -sign), through three other planes.
-          const double big = std::max({std::abs(p.x.to_double()), std::abs(p.y.to_double()),
-                                       std::abs(p.z.to_double())});
+          const double big = std::max(
+              {std::abs(p.x.to_double()), std::abs(p.y.to_double()), std::abs(p.z.to_double())});
           const ExactN t(std::ldexp(sign * big, -bits));
           const V3<ExactN> q{p.x + t * ExactN(0.3), p.y + t * ExactN(0.3),
                              p.z + t * ExactN(0.9 + 0x1p-30)};
@@ -464,8 +465,8 @@ TEST_CASE("halfspace_intersection: the precise side and compare signs are exact"
           // Exact zeros: the fourth plane through p; v = u on other planes.
           hs[3] = plane_through({0.3, 0.3, 0.9 + 0x1p-30}, p, scale);
           for (int i = 0; i < 3; ++i)
-            hs[4 + i] = three_through({0.9, -0.2, 0.3}, {0.1, 0.8, -0.4}, {-0.5, 0.2, 0.9}, p,
-                                      -scale)[i];
+            hs[4 + i] =
+                three_through({0.9, -0.2, 0.3}, {0.1, 0.8, -0.4}, {-0.5, 0.2, 0.9}, p, -scale)[i];
           const PreciseProbe zero = probe_precise(hs);
           CHECK(zero.side == 2);
           CHECK(zero.compare == 2);
@@ -486,9 +487,10 @@ TEST_CASE("halfspace_intersection: vertices on rounding midpoints round to even"
       const double x = std::ldexp(1.0, s), ulp = std::nextafter(x, HUGE_VAL) - x;
       const Exact m = Exact(x) + Exact(ulp / 2) + (k ? Exact(std::ldexp(ulp, -k)) : Exact(0));
       std::vector<HalfSpace> hs;
-      const double axes[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0},
-                                 {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-      for (const auto& a : axes) hs.push_back(plane(a[0], a[1], a[2], m, static_cast<int>(hs.size())));
+      const double axes[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                 {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+      for (const auto& a : axes)
+        hs.push_back(plane(a[0], a[1], a[2], m, static_cast<int>(hs.size())));
       hs.push_back(plane(1, 1, 1, Exact(3) * m - Exact(ulp), 6));  // cuts one corner
       const MaybePolytope r = checked(hs);
       REQUIRE(r.polytope);

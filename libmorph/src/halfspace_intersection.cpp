@@ -265,7 +265,9 @@ struct Magnitude {
   friend Magnitude operator*(Magnitude a, Magnitude b) { return {a.v * b.v}; }
 };
 Magnitude magnitude(const DD& x) { return {std::abs(x.hi)}; }
-V3<Magnitude> magnitude(const V3<DD>& p) { return {magnitude(p.x), magnitude(p.y), magnitude(p.z)}; }
+V3<Magnitude> magnitude(const V3<DD>& p) {
+  return {magnitude(p.x), magnitude(p.y), magnitude(p.z)};
+}
 
 constexpr double kEvaluation = 32 * kU2;  // (b)
 
@@ -336,8 +338,7 @@ void make_precise(const std::vector<PrecisePlane>& planes, HVertex& v) {
     v.precise = true;
     return;
   }
-  const PrecisePlane &a = planes[v.planes[0]], &b = planes[v.planes[1]],
-                     &c = planes[v.planes[2]];
+  const PrecisePlane &a = planes[v.planes[0]], &b = planes[v.planes[1]], &c = planes[v.planes[2]];
   if (!a.valid || !b.valid || !c.valid) return;
   meet(normal_dd(a), a.c[3], normal_dd(b), b.c[3], normal_dd(c), c.c[3], v.px, v.pw);
   V3<Magnitude> mx;
@@ -375,8 +376,8 @@ int precise_compare(const PrecisePlane& p, const HVertex& u, const HVertex& v) {
   const V3<Magnitude> nm = normal_magnitude(p);
   const double mu = dot(nm, magnitude(u.px)).v, mv = dot(nm, magnitude(v.px)).v;
   const double wu = std::abs(u.pw.hi), wv = std::abs(v.pw.hi);
-  // <n, X> moves by eu (ev) with the vertex, then each product by that times W and <n, X>
-  // (with its move) times W's move.
+  // <n, Xu> moves by du with u's errors (dv for v), so each product by that times W (with
+  // its move) and <n, X> (with its move) times W's move.
   const double du = nm.x.v * u.ex.x + nm.y.v * u.ex.y + nm.z.v * u.ex.z,
                dv = nm.x.v * v.ex.x + nm.y.v * v.ex.y + nm.z.v * v.ex.z;
   const double moved = du * (wv + v.ew) + (mu + du) * v.ew + dv * (wu + u.ew) + (mv + dv) * u.ew;
@@ -415,9 +416,7 @@ int side_filter(const Plane& p, LazyPrecisePlane& precise, const HVertex& v) {
   const PrecisePlane& q = precise.get();
   return q.valid ? precise_side(q, v) : 2;
 }
-int side_exact(const Plane& p, const HVertex& v) {
-  return CGAL::sign(dot(p.n, v.X) - p.d * v.W);
-}
+int side_exact(const Plane& p, const HVertex& v) { return CGAL::sign(dot(p.n, v.X) - p.d * v.W); }
 
 /// Sign of <n, x> - d at a vertex, its exact coordinates computed when the filter fails
 /// (the vertices are not precise yet where this is used).
@@ -430,8 +429,7 @@ int side(const std::vector<Plane>& planes, const Plane& p, HVertex& v) {
 
 /// Sign of <n, u> - <n, v> from the filters alone, or 2 (two known points skip the
 /// precise stage, as in side_filter).
-int compare_filter(const Plane& p, LazyPrecisePlane& precise, const HVertex& u,
-                   const HVertex& v) {
+int compare_filter(const Plane& p, LazyPrecisePlane& precise, const HVertex& u, const HVertex& v) {
   const int s = interval_sign(dot(p.ni, u.xi) - dot(p.ni, v.xi));
   if (s != 2 || !u.precise || !v.precise || (u.known >= 0 && v.known >= 0)) return s;
   CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
@@ -447,7 +445,9 @@ int compare_exact(const Plane& p, const HVertex& u, const HVertex& v) {
 class LazyExact {
  public:
   LazyExact(const std::vector<Plane>& planes, std::vector<HVertex>& vertex)
-      : planes_(planes), vertex_(vertex), once_(std::make_unique<std::once_flag[]>(vertex.size())) {}
+      : planes_(planes),
+        vertex_(vertex),
+        once_(std::make_unique<std::once_flag[]>(vertex.size())) {}
   const HVertex& operator()(int v) {
     std::call_once(once_[v], [&] { make_exact(planes_, vertex_[v]); });
     return vertex_[v];
@@ -763,7 +763,8 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       for (std::size_t q = 0; q < plateau.size(); ++q)
         for (int a = adj_begin[plateau[q]]; a < adj_begin[plateau[q] + 1]; ++a)
           if (std::find(plateau.begin(), plateau.end(), adj[a]) == plateau.end() &&
-              (known_through(known, others[j], vertex[adj[a]]) || side_of(p, precise_p, adj[a]) == 0))
+              (known_through(known, others[j], vertex[adj[a]]) ||
+               side_of(p, precise_p, adj[a]) == 0))
             plateau.push_back(adj[a]);
       std::sort(plateau.begin(), plateau.end());
     }
