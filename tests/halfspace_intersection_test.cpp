@@ -454,3 +454,188 @@ TEST_CASE("halfspace_intersection: an erosion's guess on tiny, huge and far oper
     CHECK(r.polytope->num_faces() == A.num_faces());
   }
 }
+namespace {
+
+/// The exact value of a dyadic ExactN as a rational.
+double rounded_exactly(const ExactN& x) { return round_to_nearest(Exact(x)); }
+bool same_double(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+/// The half-space <n, x> <= <n, p> (its plane through p), its normal scaled by 2^scale.
+HalfSpace plane_through(const V3<double>& n, const V3<ExactN>& p, int scale) {
+  const V3<ExactN> m =
+      to_exact_n({std::ldexp(n.x, scale), std::ldexp(n.y, scale), std::ldexp(n.z, scale)});
+  return {m, dot(m, p), ExactN(1), 0, -1};
+}
+
+/// Three half-spaces through p with normals a, b, c ordered so their det is positive.
+std::vector<HalfSpace> three_through(V3<double> a, V3<double> b, const V3<double>& c,
+                                     const V3<ExactN>& p, int scale) {
+  if (CGAL::sign(det(to_exact_n(a), to_exact_n(b), to_exact_n(c))) < 0) std::swap(a, b);
+  return {plane_through(a, p, scale), plane_through(b, p, scale), plane_through(c, p, scale)};
+}
+
+/// A point whose coordinates are rounding midpoints (ties), or within 2^-k ulp of one.
+struct NearTie {
+  V3<ExactN> p;
+  int k;  // 1: exact ties; 0: doubles; more: 2^-k ulp off the midpoints
+};
+
+/// Near ties of doubles of very different sizes, scaled by 2^s.
+std::vector<NearTie> adversarial_points() {
+  std::vector<NearTie> points;
+  const double bases[] = {1.0, 3.0, -5.0, 0.1, 12345.678, -0x1p40 - 1, 1e-3};
+  for (int s : {0, -200, 200}) {
+    for (int k : {1, 0, 10, 30, 45, 52, 60, 80}) {  // 1: an exact tie; 0: a double
+      V3<ExactN> p;
+      ExactN* c[3] = {&p.x, &p.y, &p.z};
+      for (int i = 0; i < 3; ++i) {
+        const double x = std::ldexp(bases[(k + 2 * i + s / 100 + 7) % 7], s);
+        const double ulp = std::nextafter(x, HUGE_VAL) - x;
+        ExactN v = ExactN(x);
+        if (k >= 1) v = v + ExactN(ulp / 2);                            // the midpoint
+        if (k > 1) v = v + ExactN(std::ldexp(ulp, -k) * (i ? 1 : -1));  // just off it
+        *c[i] = v;
+      }
+      points.push_back({p, k});
+    }
+  }
+  return points;
+}
+
+}  // namespace
+
+// The precise (double-double) stage rounds a vertex's coordinates only when its enclosure
+// lies strictly between two rounding midpoints: on exact ties and points within 2^-60 ulp
+// of one it must decline, and what it decides must be the exact rounding (ties to even),
+// also for nearly parallel planes, normals scaled by 2^+-200 and points far from the origin.
+TEST_CASE("halfspace_intersection: the precise stage rounds vertices as the exact rounding") {
+  const std::vector<V3<double>> normals = {
+      {1, 0.25, -0.5}, {-0.3, 1, 0.1}, {0.2, -0.7, 1}, {0.6, 0.8, 0}, {0.577, 0.577, 0.578}};
+  int decided = 0, total = 0, far_from_ties = 0, far_decided = 0;
+  for (const auto& [p, k] : adversarial_points()) {
+    for (int scale : {0, -200, 200}) {
+      for (double tilt : {0.0, 0x1p-20, 0x1p-45}) {  // the third normal nearly the first
+        for (std::size_t a = 0; a + 2 < normals.size(); ++a) {
+          const V3<double> n0 = normals[a], n1 = normals[a + 1];
+          const V3<double> n2 =
+              tilt == 0 ? normals[a + 2] : V3<double>{n0.x + tilt, n0.y - tilt, n0.z + tilt / 3};
+          const PreciseProbe probe = probe_precise(three_through(n0, n1, n2, p, scale));
+          const ExactN* c[3] = {&p.x, &p.y, &p.z};
+          const double got[3] = {probe.rounded.x, probe.rounded.y, probe.rounded.z};
+          for (int i = 0; i < 3; ++i) {
+            ++total;
+            // Within 2^-52 ulp of a tie (2^-104 relative): always inside the enclosure.
+            if (k == 1 || k >= 52) CHECK(!probe.decided[i]);
+            if (!probe.decided[i]) continue;
+            ++decided;
+            CHECK(same_double(got[i], rounded_exactly(*c[i])));
+          }
+          // Far from a tie relative to the vertex's size (its largest coordinate): the
+          // error bound is about 2^-95 of that for these well-conditioned normals.
+          const double largest = std::max(
+              {std::abs(p.x.to_double()), std::abs(p.y.to_double()), std::abs(p.z.to_double())});
+          for (int i = 0; i < 3; ++i) {
+            const double x = c[i]->to_double(),
+                         ulp = std::nextafter(std::abs(x), HUGE_VAL) - std::abs(x);
+            const double distance = k == 0 ? ulp / 2 : std::ldexp(ulp, -k);
+            if (tilt == 0 && k != 1 && distance >= 0x1p-80 * largest)
+              far_from_ties++, far_decided += probe.decided[i];
+          }
+        }
+      }
+    }
+  }
+  // Well-conditioned vertices far (in ulps) from a tie are decided without exact arithmetic.
+  CHECK(far_decided == far_from_ties);
+  CHECK(far_from_ties > 50);
+  CHECK(decided > far_decided);  // some nearly parallel ones too
+  // Known points X / W (erosion vertices) take the same stage: ties and near-ties with odd
+  // W decline, the rest rounds as the exact rounding; beyond the range it declines.
+  for (const auto& [p, k] : adversarial_points()) {
+    for (const double w : {1.0, 3.0, 0x1p-300, 0x1p300 * 5}) {
+      const ExactN W(w);
+      const PreciseProbe probe = probe_precise_point({p.x * W, p.y * W, p.z * W}, W);
+      const ExactN* c[3] = {&p.x, &p.y, &p.z};
+      const double got[3] = {probe.rounded.x, probe.rounded.y, probe.rounded.z};
+      for (int i = 0; i < 3; ++i)
+        if (probe.decided[i]) CHECK(same_double(got[i], rounded_exactly(*c[i])));
+    }
+  }
+  const ExactN huge = ExactN(0x1p600) * ExactN(0x1p600);
+  CHECK(!probe_precise_point({huge, ExactN(1), ExactN(-1)}, ExactN(1)).decided[0]);
+  CHECK(!probe_precise_point({ExactN(1), ExactN(1), ExactN(1)}, huge).decided[0]);
+}
+
+// The precise stage of side and compare_along: exact zeros (a fourth plane through the
+// vertex, two vertices on one plane parallel to the fourth) stay undecided, and every
+// sign it decides is the exact sign, down to moves of 2^-90 relative.
+TEST_CASE("halfspace_intersection: the precise side and compare signs are exact") {
+  int decided = 0;
+  for (const auto& [p, k] : adversarial_points()) {
+    for (int scale : {0, -200, 200}) {
+      for (int bits : {20, 60, 90, 120}) {
+        for (int sign : {1, -1}) {
+          std::vector<HalfSpace> hs =
+              three_through({1, 0.25, -0.5}, {-0.3, 1, 0.1}, {0.2, -0.7, 1}, p, scale);
+          // The fourth plane through p, moved by 2^-bits of the magnitude of <n, p>.
+          HalfSpace h = plane_through({0.3, 0.3, 0.9 + 0x1p-30}, p, scale);
+          const double size = std::abs(h.normal.x.to_double() * p.x.to_double()) +
+                              std::abs(h.normal.y.to_double() * p.y.to_double()) +
+                              std::abs(h.normal.z.to_double() * p.z.to_double());
+          const ExactN move(std::ldexp(sign * size, -bits));
+          h.offset = h.offset + move;
+          hs.push_back(h);
+          // v: p moved along the fourth plane's normal times 2^-bits of p's size (the
+          // sign of <n, u - v> is -sign), through three other planes.
+          const double big = std::max(
+              {std::abs(p.x.to_double()), std::abs(p.y.to_double()), std::abs(p.z.to_double())});
+          const ExactN t(std::ldexp(sign * big, -bits));
+          const V3<ExactN> q{p.x + t * ExactN(0.3), p.y + t * ExactN(0.3),
+                             p.z + t * ExactN(0.9 + 0x1p-30)};
+          for (const HalfSpace& g :
+               three_through({0.9, -0.2, 0.3}, {0.1, 0.8, -0.4}, {-0.5, 0.2, 0.9}, q, -scale))
+            hs.push_back(g);
+          const PreciseProbe probe = probe_precise(hs);
+          const int want_side = CGAL::sign(dot(h.normal, p) - h.offset);
+          const int want_compare = CGAL::sign(dot(h.normal, p) - dot(h.normal, q));
+          if (probe.side != 2) CHECK(probe.side == want_side);
+          if (probe.compare != 2) CHECK(probe.compare == want_compare);
+          decided += (probe.side != 2) + (probe.compare != 2);
+          if (bits <= 60) CHECK(probe.side != 2);
+          if (bits <= 60) CHECK(probe.compare != 2);
+          // Exact zeros: the fourth plane through p; v = u on other planes.
+          hs[3] = plane_through({0.3, 0.3, 0.9 + 0x1p-30}, p, scale);
+          for (int i = 0; i < 3; ++i)
+            hs[4 + i] =
+                three_through({0.9, -0.2, 0.3}, {0.1, 0.8, -0.4}, {-0.5, 0.2, 0.9}, p, -scale)[i];
+          const PreciseProbe zero = probe_precise(hs);
+          CHECK(zero.side == 2);
+          CHECK(zero.compare == 2);
+        }
+      }
+    }
+  }
+  CHECK(decided > 0);
+}
+
+// Whole intersections whose vertices are exact ties or just off them: the cube
+// [-m, m]^3 for m a midpoint between doubles (scaled by 2^+-200), and moved by 2^-80 ulp;
+// the rounded result must be the exact one rounded (checked), with or without the exact
+// polytope.
+TEST_CASE("halfspace_intersection: vertices on rounding midpoints round to even") {
+  for (int s : {0, -200, 200}) {
+    for (int k : {0, 80}) {
+      const double x = std::ldexp(1.0, s), ulp = std::nextafter(x, HUGE_VAL) - x;
+      const Exact m = Exact(x) + Exact(ulp / 2) + (k ? Exact(std::ldexp(ulp, -k)) : Exact(0));
+      std::vector<HalfSpace> hs;
+      const double axes[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                 {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+      for (const auto& a : axes)
+        hs.push_back(plane(a[0], a[1], a[2], m, static_cast<int>(hs.size())));
+      hs.push_back(plane(1, 1, 1, Exact(3) * m - Exact(ulp), 6));  // cuts one corner
+      const MaybePolytope r = checked(hs);
+      REQUIRE(r.polytope);
+      CHECK(r.polytope->num_vertices() == 10);
+    }
+  }
+}

@@ -10,6 +10,9 @@
 #include <CGAL/Mpzf.h>
 
 #include <array>
+#include <cmath>
+#include <limits>
+#include <utility>
 
 namespace morph::detail {
 
@@ -68,6 +71,58 @@ inline V3<T> newell_normal(int n, const PointAt& point_at) {
     sum.z += (p.x - q.x) * (p.y + q.y);
   }
   return sum;
+}
+
+/// Double-double arithmetic (Dekker, Knuth; as in Hida, Li and Bailey's QD library),
+/// valid in round-to-nearest only. A value is hi + lo with |lo| <= ulp(hi) / 2. Each
+/// operation below errs by at most 4u^2 (u = 2^-53) times the magnitude of its operands'
+/// sum or product; the error bounds built on them are generous multiples of that.
+struct DD {
+  double hi, lo;
+};
+inline DD two_sum(double a, double b) {
+  const double s = a + b, bb = s - a;
+  return {s, (a - (s - bb)) + (b - bb)};
+}
+inline DD quick_two_sum(double a, double b) {
+  const double s = a + b;
+  return {s, b - (s - a)};
+}
+inline DD split(double a) {          // Veltkamp: a = hi + lo with 26-bit halves (|a| < 2^995)
+  const double c = 134217729.0 * a;  // 2^27 + 1
+  const double hi = c - (c - a);
+  return {hi, a - hi};
+}
+inline DD two_prod(double a, double b) {  // Dekker; inline, unlike a call to std::fma
+  const double p = a * b;
+  const DD x = split(a), y = split(b);
+  return {p, ((x.hi * y.hi - p) + x.hi * y.lo + x.lo * y.hi) + x.lo * y.lo};
+}
+inline DD operator+(const DD& a, const DD& b) {
+  const DD s = two_sum(a.hi, b.hi);
+  return quick_two_sum(s.hi, s.lo + (a.lo + b.lo));
+}
+inline DD operator-(const DD& a) { return {-a.hi, -a.lo}; }
+inline DD operator-(const DD& a, const DD& b) { return a + -b; }
+inline DD operator*(const DD& a, const DD& b) {
+  const DD p = two_prod(a.hi, b.hi);
+  return quick_two_sum(p.hi, p.lo + (a.hi * b.lo + a.lo * b.hi));
+}
+inline constexpr double kU2 = 0x1p-106;  // u^2
+
+/// x as a double-double, in round-to-nearest, and in `error` a bound on its distance to x
+/// (infinite when x is beyond the doubles). One exact subtraction: x - hi is enclosed by
+/// Mpzf from its limbs (in any rounding mode) between equal or neighbouring doubles l <= h,
+/// so x lies in [hi + l, hi + h].
+inline DD to_dd(const ExactN& x, double& error) {
+  const double hi = x.to_double();  // within an ulp of x
+  if (!std::isfinite(hi)) {
+    error = std::numeric_limits<double>::infinity();
+    return {hi, 0};
+  }
+  const std::pair<double, double> rest = (x - ExactN(hi)).to_interval();
+  error = rest.second - rest.first;  // exact: neighbours, or a subnormal and zero
+  return quick_two_sum(hi, rest.first);
 }
 
 /// Sign of an interval, or 2 when it straddles zero (undecided).

@@ -37,6 +37,8 @@
 #include <cstring>
 #include <deque>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <numeric>
 
 #include "fims.h"
@@ -172,7 +174,8 @@ DualSurface surface_of(const HullMesh& hull, const IndexOf& index_of) {
 }
 
 /// A vertex of the intersection in homogeneous coordinates: X / W with W > 0, the meet
-/// of three of the planes. The exact coordinates are computed when first needed.
+/// of three of the planes. The exact coordinates are computed only where the filters
+/// (intervals, then double-double) cannot decide, or for a polytope chained further.
 struct HVertex {
   std::array<int, 3> planes;
   V3<Interval> Xi;
@@ -182,6 +185,14 @@ struct HVertex {
   V3<ExactN> X;
   ExactN W;
   int known = -1;  // the known point it is (KnownPoints), if any
+  // X and W times some positive factor in double-double, within ex and ew of the exact
+  // ones times that factor (make_precise); only when `precise`.
+  V3<DD> px{};
+  DD pw{};
+  V3<double> ex{};
+  double ew = 0;
+  bool precise = false;
+  bool doubles = false;  // a known point X / 1 with X exactly doubles: its rounding is X
 };
 
 /// The point of three planes (Cramer's rule); W = det(n_a, n_b, n_c).
@@ -235,23 +246,251 @@ void make_exact(const std::vector<Plane>& planes, HVertex& v) {
   v.has_exact = true;
 }
 
-/// Sign of <n, x> - d at a vertex: > 0 when the vertex violates the half-space. Exact
-/// coordinates are computed when the filter fails (`make_exact`), or must be there.
-int side(const Plane& p, const HVertex& v) {
-  const int s = interval_sign(dot(p.ni, v.Xi) - p.di * v.Wi);
-  return s != 2 ? s : CGAL::sign(dot(p.n, v.X) - p.d * v.W);
+// The precise stage. Every value below is a polynomial in precise components (a plane's
+// n and d, a vertex's X and W), evaluated in double-double (round-to-nearest) along with
+// its magnitude: the same polynomial on the |hi| of its inputs with every subtraction
+// turned into an addition, which bounds every term and partial sum. Its error is bounded
+// by (a) the inputs' errors: kPlaneRelative of |hi| per plane component (a monomial of
+// degree k moves by at most k kPlaneRelative of its magnitude, to first order), and what a
+// vertex's ex and ew move; (b) the evaluation: at most five levels of operations, each
+// within 4 u^2 of its operands' magnitudes, so 20 u^2 of the magnitude, taken as 32 u^2;
+// (c) underflow, an absolute term. A margin of 1% covers second-order terms and the
+// rounding of the bound itself.
+
+/// The magnitude arithmetic: subtraction adds.
+struct Magnitude {
+  double v;
+  friend Magnitude operator+(Magnitude a, Magnitude b) { return {a.v + b.v}; }
+  friend Magnitude operator-(Magnitude a, Magnitude b) { return {a.v + b.v}; }
+  friend Magnitude operator*(Magnitude a, Magnitude b) { return {a.v * b.v}; }
+};
+Magnitude magnitude(const DD& x) { return {std::abs(x.hi)}; }
+V3<Magnitude> magnitude(const V3<DD>& p) {
+  return {magnitude(p.x), magnitude(p.y), magnitude(p.z)};
 }
+
+constexpr double kEvaluation = 32 * kU2;  // (b)
+
+/// Relative error of each component of a precise plane (a).
+constexpr double kPlaneRelative = 0x1p-100;
+
+/// Four exact values in double-double, each within kPlaneRelative of |hi|, all scaled by
+/// the power of two that brings the largest |c[k]|, k in [lead_begin, lead_end), into
+/// [1, 2); false when a value is beyond 2^400 or a non-zero one below 2^-900 after that
+/// (round-to-nearest).
+bool precise_scaled(const std::array<const ExactN*, 4>& c, int lead_begin, int lead_end,
+                    std::array<DD, 4>& out) {
+  std::array<DD, 4> v{};
+  double largest = 0;
+  for (int k = 0; k < 4; ++k) {
+    if (CGAL::sign(*c[k]) == CGAL::ZERO) continue;
+    double error;
+    v[k] = to_dd(*c[k], error);
+    // Half the allowed error: scaling may round a subnormal lo (by 2^-1075 at most).
+    if (!(error <= kPlaneRelative / 2 * std::abs(v[k].hi))) return false;
+    if (k >= lead_begin && k < lead_end) largest = std::max(largest, std::abs(v[k].hi));
+  }
+  if (!(largest >= 0x1p-1000 && largest < 0x1p1000)) return false;
+  const double scale = std::ldexp(1.0, -std::ilogb(largest));  // exact products
+  for (int k = 0; k < 4; ++k) {
+    if (v[k].hi == 0) continue;
+    v[k] = {v[k].hi * scale, v[k].lo * scale};
+    if (!(std::abs(v[k].hi) >= 0x1p-900 && std::abs(v[k].hi) <= 0x1p400)) return false;
+  }
+  out = v;
+  return true;
+}
+
+/// A plane's n.x, n.y, n.z, d times a power of two (any positive factor leaves every sign
+/// and every meet unchanged) in double-double: precise_scaled with the largest normal
+/// component in [1, 2), so |d| <= 2^400 and every non-zero component is above 2^-900 (the
+/// precise stage neither overflows nor loses a component). Not `valid` out of that range.
+struct PrecisePlane {
+  std::array<DD, 4> c{};
+  bool valid = false;
+};
+PrecisePlane precise_plane(const Plane& plane) {
+  PrecisePlane p;
+  p.valid = precise_scaled({&plane.n.x, &plane.n.y, &plane.n.z, &plane.d}, 0, 3, p.c);
+  return p;
+}
+V3<DD> normal_dd(const PrecisePlane& p) { return {p.c[0], p.c[1], p.c[2]}; }
+V3<Magnitude> normal_magnitude(const PrecisePlane& p) { return magnitude(normal_dd(p)); }
+
+/// The precise coordinates of a vertex (round-to-nearest): a known point's from its exact
+/// ones (W in [1, 2)), another's as the meet of its precise planes. Left out when a plane
+/// is not valid or a value out of range.
+void make_precise(const std::vector<PrecisePlane>& planes, HVertex& v) {
+  if (v.known >= 0) {
+    const auto is_double = [](const ExactN& x) {
+      const double d = x.to_double();
+      return std::isfinite(d) && x == ExactN(d);
+    };
+    v.doubles = v.W.is_one() && is_double(v.X.x) && is_double(v.X.y) && is_double(v.X.z);
+    if (v.doubles) return;  // (a closing's vertices, A's own)
+    std::array<DD, 4> c;
+    if (!precise_scaled({&v.X.x, &v.X.y, &v.X.z, &v.W}, 3, 4, c)) return;
+    v.px = {c[0], c[1], c[2]};
+    v.pw = c[3];
+    v.ex = {kPlaneRelative * std::abs(c[0].hi), kPlaneRelative * std::abs(c[1].hi),
+            kPlaneRelative * std::abs(c[2].hi)};
+    v.ew = kPlaneRelative * c[3].hi;
+    v.precise = true;
+    return;
+  }
+  const PrecisePlane &a = planes[v.planes[0]], &b = planes[v.planes[1]], &c = planes[v.planes[2]];
+  if (!a.valid || !b.valid || !c.valid) return;
+  meet(normal_dd(a), a.c[3], normal_dd(b), b.c[3], normal_dd(c), c.c[3], v.px, v.pw);
+  V3<Magnitude> mx;
+  Magnitude mw;
+  meet(normal_magnitude(a), magnitude(a.c[3]), normal_magnitude(b), magnitude(b.c[3]),
+       normal_magnitude(c), magnitude(c.c[3]), mx, mw);
+  // Degree 3 in the planes' components; underflow in the cross products is multiplied by
+  // at most |d| (no overflow: |n| < 2, |d| <= 2^400).
+  constexpr double factor = (3 * kPlaneRelative + kEvaluation) * 1.01;
+  const double absolute =
+      0x1p-960 * (1 + std::abs(a.c[3].hi) + std::abs(b.c[3].hi) + std::abs(c.c[3].hi));
+  v.ex = {factor * mx.x.v + absolute, factor * mx.y.v + absolute, factor * mx.z.v + absolute};
+  v.ew = factor * mw.v + 0x1p-960;
+  v.precise = true;
+}
+
+/// Sign of <n, X> - d W from the precise stage, or 2 (round-to-nearest; both precise).
+int precise_side(const PrecisePlane& p, const HVertex& v) {
+  const DD value = dot(normal_dd(p), v.px) - p.c[3] * v.pw;
+  const V3<Magnitude> n = normal_magnitude(p);
+  const Magnitude m = dot(n, magnitude(v.px)) - magnitude(p.c[3]) * magnitude(v.pw);
+  const double moved = n.x.v * v.ex.x + n.y.v * v.ex.y + n.z.v * v.ex.z +
+                       std::abs(p.c[3].hi) * v.ew;  // by the vertex's errors
+  const double bound = ((kPlaneRelative + kEvaluation) * m.v + moved) * 1.01 + 0x1p-1000;
+  if (value.hi > bound) return 1;
+  if (value.hi < -bound) return -1;
+  return 2;
+}
+
+/// Sign of <n, Xu> Wv - <n, Xv> Wu from the precise stage, or 2 (round-to-nearest; all
+/// precise). Each vertex's own factor is positive, so the sign is that of <n, u - v>.
+int precise_compare(const PrecisePlane& p, const HVertex& u, const HVertex& v) {
+  const V3<DD> n = normal_dd(p);
+  const DD value = dot(n, u.px) * v.pw - dot(n, v.px) * u.pw;
+  const V3<Magnitude> nm = normal_magnitude(p);
+  const double mu = dot(nm, magnitude(u.px)).v, mv = dot(nm, magnitude(v.px)).v;
+  const double wu = std::abs(u.pw.hi), wv = std::abs(v.pw.hi);
+  // <n, Xu> moves by du with u's errors (dv for v), so each product by that times W (with
+  // its move) and <n, X> (with its move) times W's move.
+  const double du = nm.x.v * u.ex.x + nm.y.v * u.ex.y + nm.z.v * u.ex.z,
+               dv = nm.x.v * v.ex.x + nm.y.v * v.ex.y + nm.z.v * v.ex.z;
+  const double moved = du * (wv + v.ew) + (mu + du) * v.ew + dv * (wu + u.ew) + (mv + dv) * u.ew;
+  const double bound =
+      ((kPlaneRelative + kEvaluation) * (mu * wv + mv * wu) + moved) * 1.01 + 0x1p-990;
+  if (value.hi > bound) return 1;
+  if (value.hi < -bound) return -1;
+  return 2;
+}
+
+/// A plane's precise copy, made when a filter first needs it (by the one thread that
+/// tests that plane).
+class LazyPrecisePlane {
+ public:
+  explicit LazyPrecisePlane(const Plane& plane) : plane_(plane) {}
+  const PrecisePlane& get() {  // round-to-nearest
+    if (!made_) precise_ = precise_plane(plane_);
+    made_ = true;
+    return precise_;
+  }
+
+ private:
+  const Plane& plane_;
+  PrecisePlane precise_;
+  bool made_ = false;
+};
+
+/// Sign of <n, x> - d at a vertex from the filters alone (intervals, then the precise
+/// stage in round-to-nearest), or 2: > 0 when the vertex violates the half-space. A known
+/// point skips the precise stage: its exact coordinates are there, and small (in a closing
+/// the undecided tests are mostly exact zeros, planes touching the result).
+int side_filter(const Plane& p, LazyPrecisePlane& precise, const HVertex& v) {
+  const int s = interval_sign(dot(p.ni, v.Xi) - p.di * v.Wi);
+  if (s != 2 || !v.precise || v.known >= 0) return s;
+  CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+  const PrecisePlane& q = precise.get();
+  return q.valid ? precise_side(q, v) : 2;
+}
+int side_exact(const Plane& p, const HVertex& v) { return CGAL::sign(dot(p.n, v.X) - p.d * v.W); }
+
+/// Sign of <n, x> - d at a vertex, its exact coordinates computed when the filter fails
+/// (the vertices are not precise yet where this is used).
 int side(const std::vector<Plane>& planes, const Plane& p, HVertex& v) {
   const int s = interval_sign(dot(p.ni, v.Xi) - p.di * v.Wi);
   if (s != 2) return s;
   make_exact(planes, v);
-  return CGAL::sign(dot(p.n, v.X) - p.d * v.W);
+  return side_exact(p, v);
 }
 
-/// Sign of <n, u> - <n, v> (exact coordinates there).
-int compare_along(const Plane& p, const HVertex& u, const HVertex& v) {
+/// Sign of <n, u> - <n, v> from the filters alone, or 2 (two known points skip the
+/// precise stage, as in side_filter).
+int compare_filter(const Plane& p, LazyPrecisePlane& precise, const HVertex& u, const HVertex& v) {
   const int s = interval_sign(dot(p.ni, u.xi) - dot(p.ni, v.xi));
-  return s != 2 ? s : CGAL::sign(dot(p.n, u.X) * v.W - dot(p.n, v.X) * u.W);
+  if (s != 2 || !u.precise || !v.precise || (u.known >= 0 && v.known >= 0)) return s;
+  CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+  const PrecisePlane& q = precise.get();
+  return q.valid ? precise_compare(q, u, v) : 2;
+}
+int compare_exact(const Plane& p, const HVertex& u, const HVertex& v) {
+  return CGAL::sign(dot(p.n, u.X) * v.W - dot(p.n, v.X) * u.W);
+}
+
+/// Exact vertex coordinates made on first use, by whichever thread needs them first (each
+/// at most once; they do not depend on the thread, so neither does any decision).
+class LazyExact {
+ public:
+  LazyExact(const std::vector<Plane>& planes, std::vector<HVertex>& vertex)
+      : planes_(planes),
+        vertex_(vertex),
+        once_(std::make_unique<std::once_flag[]>(vertex.size())) {}
+  const HVertex& operator()(int v) {
+    std::call_once(once_[v], [&] { make_exact(planes_, vertex_[v]); });
+    return vertex_[v];
+  }
+
+ private:
+  const std::vector<Plane>& planes_;
+  std::vector<HVertex>& vertex_;
+  std::unique_ptr<std::once_flag[]> once_;
+};
+
+/// X / W rounded to nearest (ties to even) from precise coordinates, when their enclosure
+/// lies strictly between two rounding midpoints (round-to-nearest); false otherwise (too
+/// close to a midpoint, or out of range): the exact rounding decides. X is within ex of
+/// the exact X, W within ew (both times the vertex's factor).
+bool round_precise(const DD& X, double ex, const DD& W, double ew, double& out) {
+  if (!(W.hi >= 0x1p-300 && W.hi <= 0x1p300) || !(ew <= 0x1p-60 * W.hi)) return false;
+  // The residual R = X - r W in double-double: the product r W.hi is exact (Dekker), and
+  // so is the cancelling X.hi - p.hi; what remains is small. `sum` bounds those small
+  // terms, whose three additions and the last one err by 2^-53 of them each.
+  double sum = 0;
+  const auto residual = [&](double r) {
+    const DD p = two_prod(r, W.hi), s = two_sum(X.hi, -p.hi);
+    const double q = r * W.lo;
+    sum = std::abs(s.lo) + std::abs(X.lo) + std::abs(p.lo) + std::abs(q);
+    return s.hi + (((s.lo + X.lo) - p.lo) - q);
+  };
+  const double q1 = X.hi / W.hi;
+  if (!(std::abs(q1) >= 0x1p-490 && std::abs(q1) <= 0x1p490)) return false;
+  const double r = q1 + residual(q1) / W.hi;  // X / W to about 100 bits: the candidate
+  if (!(std::abs(r) >= 0x1p-500 && std::abs(r) <= 0x1p500)) return false;
+  const double R = residual(r);
+  // X / W - r = R / W up to the errors: those of X and W, and of R's evaluation.
+  const double error = (ex + std::abs(r) * ew + 0x1p-50 * (sum + std::abs(R))) * 1.01 + 0x1p-1000;
+  // X / W lies strictly between the midpoints to r's neighbours iff
+  // -(r - down) / 2 < R / W < (up - r) / 2; the exact W >= W.hi - |W.lo| - ew >= w_low > 0
+  // (|W.lo| <= 2^-53 W.hi), and the half gaps are powers of two (products exact: no
+  // underflow in this range).
+  const double w_low = W.hi * (1 - 0x1p-50);
+  const double up = std::nextafter(r, HUGE_VAL) - r, down = r - std::nextafter(r, -HUGE_VAL);
+  if (!(R + error < 0.5 * up * w_low && R - error > -0.5 * down * w_low)) return false;
+  out = r;
+  return true;
 }
 
 int det_sign(const Plane& a, const Plane& b, const Plane& c) {
@@ -313,7 +552,7 @@ namespace {
 /// Whether the facet cycle `cyc` runs clockwise about `normal` (interval Newell normal of
 /// the vertices, rationals when that cannot decide).
 bool clockwise(const std::vector<int>& cyc, const std::vector<HVertex>& vertex,
-               const V3<ExactN>& normal) {
+               const V3<ExactN>& normal, LazyExact& exact_vertex) {
   const int n = static_cast<int>(cyc.size());
   {
     RoundingGuard guard;
@@ -324,7 +563,7 @@ bool clockwise(const std::vector<int>& cyc, const std::vector<HVertex>& vertex,
   }
   std::vector<V3<Exact>> exact(n);
   for (int i = 0; i < n; ++i) {
-    const HVertex& v = vertex[cyc[i]];
+    const HVertex& v = exact_vertex(cyc[i]);
     const Exact w(v.W);
     exact[i] = {Exact(v.X.x) / w, Exact(v.X.y) / w, Exact(v.X.z) / w};
   }
@@ -463,10 +702,34 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     face_halfspace.push_back(p);
   }
   if (faces.size() < 4) return std::nullopt;
-  // Exact vertices, for the rounding and for the checks below.
+  // Precise vertices, for the checks below (a second filter stage) and the rounding; exact
+  // ones only where those cannot decide (LazyExact), but all of them for a polytope that is
+  // computed with further.
+  // The planes of vertices that are not known points are made precise up front; the
+  // others when the walk below first needs them.
+  std::vector<PrecisePlane> precise(n);
+  {
+    std::vector<char> used(n, 0);
+    for (const HVertex& v : vertex)
+      if (v.known < 0) used[v.planes[0]] = used[v.planes[1]] = used[v.planes[2]] = 1;
+    parallel_chunks(n, 256, [&](int begin, int end) {
+      CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+      for (int i = begin; i < end; ++i)
+        if (used[i]) precise[i] = precise_plane(planes[i]);
+    });
+  }
   parallel_chunks(nv, 128, [&](int begin, int end) {
-    for (int v = begin; v < end; ++v) make_exact(planes, vertex[v]);
+    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    for (int v = begin; v < end; ++v) {
+      make_precise(precise, vertex[v]);
+      if (with_polytope) make_exact(planes, vertex[v]);
+    }
   });
+  LazyExact exact_vertex(planes, vertex);
+  const auto side_of = [&](const Plane& p, LazyPrecisePlane& q, int v) {
+    const int s = side_filter(p, q, vertex[v]);
+    return s != 2 ? s : side_exact(p, exact_vertex(v));
+  };
   // The candidate is a convex polytope. Every plane that is not a dual vertex must not cut
   // it: climb to its highest vertex (a local maximum is global on a convex polytope) and
   // collect the vertices where it touches (sorted).
@@ -479,17 +742,20 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     int u = 0;
     for (int j = begin; j < end && ok; ++j) {
       const Plane& p = planes[others[j]];
+      LazyPrecisePlane precise_p(p);
       for (bool moved = true; moved;) {
         moved = false;
         for (int a = adj_begin[u]; a < adj_begin[u + 1]; ++a) {
-          if (compare_along(p, vertex[adj[a]], vertex[u]) > 0) {
+          int s = compare_filter(p, precise_p, vertex[adj[a]], vertex[u]);
+          if (s == 2) s = compare_exact(p, exact_vertex(adj[a]), exact_vertex(u));
+          if (s > 0) {
             u = adj[a];
             moved = true;
             break;
           }
         }
       }
-      const int sd = known_through(known, others[j], vertex[u]) ? 0 : side(p, vertex[u]);
+      const int sd = known_through(known, others[j], vertex[u]) ? 0 : side_of(p, precise_p, u);
       if (sd > 0) ok = false;
       if (sd != 0) continue;
       std::vector<int>& plateau = touched[j];
@@ -497,7 +763,8 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       for (std::size_t q = 0; q < plateau.size(); ++q)
         for (int a = adj_begin[plateau[q]]; a < adj_begin[plateau[q] + 1]; ++a)
           if (std::find(plateau.begin(), plateau.end(), adj[a]) == plateau.end() &&
-              (known_through(known, others[j], vertex[adj[a]]) || side(p, vertex[adj[a]]) == 0))
+              (known_through(known, others[j], vertex[adj[a]]) ||
+               side_of(p, precise_p, adj[a]) == 0))
             plateau.push_back(adj[a]);
       std::sort(plateau.begin(), plateau.end());
     }
@@ -548,21 +815,37 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   {
     std::vector<int> cyc = faces[0];
     for (int& r : cyc) r = order[r];
-    if (clockwise(cyc, vertex, hs[face_halfspace[0]].normal))
+    if (clockwise(cyc, vertex, hs[face_halfspace[0]].normal, exact_vertex))
       for (auto& c : faces) std::reverse(c.begin(), c.end());
   }
-  // Rounded vertices, exactly rounded from the homogeneous coordinates; rationals only
-  // for a polytope that is computed with further.
+  // Rounded vertices, exactly rounded from the homogeneous coordinates: from the precise
+  // ones unless they lie too close to a rounding midpoint, from the exact ones then;
+  // rationals only for a polytope that is computed with further.
   MaybePolytope out;
   RoundedPolytope& rp = out.rounded;
   rp.points.resize(nv);
   ExactPoints exact;
   if (with_polytope) exact.resize(nv);
   parallel_chunks(nv, 128, [&](int begin, int end) {
+    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);  // for round_precise
+    const auto coordinate = [](const auto& p, int i) -> const auto& {
+      return i == 0 ? p.x : i == 1 ? p.y : p.z;
+    };
     for (int r = begin; r < end; ++r) {
       const HVertex& v = vertex[order[r]];
-      rp.points[r] = {round_quotient(v.X.x, v.W, v.xi.x), round_quotient(v.X.y, v.W, v.xi.y),
-                      round_quotient(v.X.z, v.W, v.xi.z)};
+      double rounded[3];
+      for (int i = 0; i < 3; ++i) {
+        if (v.doubles) {
+          rounded[i] = coordinate(v.X, i).to_double();
+          continue;
+        }
+        if (v.precise &&
+            round_precise(coordinate(v.px, i), coordinate(v.ex, i), v.pw, v.ew, rounded[i]))
+          continue;
+        const HVertex& e = exact_vertex(order[r]);
+        rounded[i] = round_quotient(coordinate(e.X, i), e.W, coordinate(v.xi, i));
+      }
+      rp.points[r] = {rounded[0], rounded[1], rounded[2]};
       if (!with_polytope) continue;
       exact.numerator[r] = v.X;
       exact.denominator[r] = v.W;
@@ -837,6 +1120,54 @@ DualSurface exact_dual_hull(const std::vector<Plane>& planes, const V3<Exact>& o
 }
 
 }  // namespace
+
+namespace {
+
+void probe_rounding(const HVertex& v, PreciseProbe& out) {
+  if (v.doubles) {
+    out.rounded = {v.X.x.to_double(), v.X.y.to_double(), v.X.z.to_double()};
+    out.decided = {true, true, true};
+  }
+  if (!v.precise) return;
+  out.decided = {round_precise(v.px.x, v.ex.x, v.pw, v.ew, out.rounded.x),
+                 round_precise(v.px.y, v.ex.y, v.pw, v.ew, out.rounded.y),
+                 round_precise(v.px.z, v.ex.z, v.pw, v.ew, out.rounded.z)};
+}
+
+}  // namespace
+
+PreciseProbe probe_precise(const std::vector<HalfSpace>& hs) {
+  const std::vector<Plane> planes = planes_of(hs);
+  CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+  std::vector<PrecisePlane> precise;
+  for (const Plane& p : planes) precise.push_back(precise_plane(p));
+  PreciseProbe out;
+  HVertex u;
+  u.planes = {0, 1, 2};
+  make_precise(precise, u);
+  probe_rounding(u, out);
+  if (hs.size() < 4 || !u.precise || !precise[3].valid) return out;
+  out.side = precise_side(precise[3], u);
+  if (hs.size() < 7) return out;
+  HVertex v;
+  v.planes = {4, 5, 6};
+  make_precise(precise, v);
+  if (v.precise) out.compare = precise_compare(precise[3], u, v);
+  return out;
+}
+
+PreciseProbe probe_precise_point(const V3<ExactN>& X, const ExactN& W) {
+  CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+  PreciseProbe out;
+  HVertex v;
+  v.known = 0;
+  v.X = X;
+  v.W = W;
+  v.has_exact = true;
+  make_precise({}, v);
+  probe_rounding(v, out);
+  return out;
+}
 
 HalfSpace make_halfspace(const V3<ExactN>& normal, const Exact& offset, int source) {
   return {normal, integer_n(offset.numerator()), integer_n(offset.denominator()), source};

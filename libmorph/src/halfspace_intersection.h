@@ -5,6 +5,7 @@
 
 #include <morph/morphology.h>
 
+#include <array>
 #include <optional>
 #include <string>
 
@@ -116,6 +117,22 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& halfspaces, con
                                    const IntersectOptions& options = {},
                                    const KnownPoints& known = {},
                                    const ExpectedVertices& expected = {});
+
+/// For tests: the precise (double-double) stage of the intersection's vertices alone.
+/// `rounded` holds the coordinates of a vertex rounded to nearest where that stage decides
+/// (`decided`; elsewhere the exact rounding is left to do); `side` and `compare` are signs
+/// it decides, or 2 where it leaves them to exact arithmetic.
+struct PreciseProbe {
+  V3<double> rounded{0, 0, 0};
+  std::array<bool, 3> decided{false, false, false};
+  int side = 2;     // of <n, u> - d for hs[3]
+  int compare = 2;  // of <n, u> - <n, v> for hs[3]'s normal n
+};
+/// u is the meet of the planes of hs[0], hs[1] and hs[2] (det of their normals > 0); v, when
+/// hs has 7 half-spaces, that of hs[4], hs[5] and hs[6].
+PreciseProbe probe_precise(const std::vector<HalfSpace>& hs);
+/// The rounding of a point known exactly, X / W (W > 0), as an erosion's known points.
+PreciseProbe probe_precise_point(const V3<ExactN>& X, const ExactN& W);
 
 /// A (-) B = intersection over facets f of A of { x : <N_f, x> <= h_A(N_f) - h_B(N_f) }.
 /// The facets of A through a vertex v moved by a vertex b of B (one that attains h_B(N_f))

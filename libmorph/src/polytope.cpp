@@ -41,43 +41,6 @@ const V3<ExactN>& Polytope::exact_normal(int f) const {
 
 namespace {
 
-// Double-double arithmetic (Dekker, Knuth; as in Hida, Li and Bailey's QD library),
-// valid in round-to-nearest only. A value is hi + lo with |lo| <= ulp(hi) / 2. Each
-// operation below errs by at most 4u^2 (u = 2^-53) times the magnitude of its operands'
-// sum or product; the error bounds built on them are generous multiples of that.
-struct DD {
-  double hi, lo;
-};
-inline DD two_sum(double a, double b) {
-  const double s = a + b, bb = s - a;
-  return {s, (a - (s - bb)) + (b - bb)};
-}
-inline DD quick_two_sum(double a, double b) {
-  const double s = a + b;
-  return {s, b - (s - a)};
-}
-inline DD split(double a) {          // Veltkamp: a = hi + lo with 26-bit halves (|a| < 2^995)
-  const double c = 134217729.0 * a;  // 2^27 + 1
-  const double hi = c - (c - a);
-  return {hi, a - hi};
-}
-inline DD two_prod(double a, double b) {  // Dekker; inline, unlike a call to std::fma
-  const double p = a * b;
-  const DD x = split(a), y = split(b);
-  return {p, ((x.hi * y.hi - p) + x.hi * y.lo + x.lo * y.hi) + x.lo * y.lo};
-}
-inline DD operator+(const DD& a, const DD& b) {
-  const DD s = two_sum(a.hi, b.hi);
-  return quick_two_sum(s.hi, s.lo + (a.lo + b.lo));
-}
-inline DD operator-(const DD& a) { return {-a.hi, -a.lo}; }
-inline DD operator-(const DD& a, const DD& b) { return a + -b; }
-inline DD operator*(const DD& a, const DD& b) {
-  const DD p = two_prod(a.hi, b.hi);
-  return quick_two_sum(p.hi, p.lo + (a.hi * b.lo + a.lo * b.hi));
-}
-constexpr double kU2 = 0x1p-106;  // u^2
-
 /// The precise normal of a facet with double points: the points scaled by a power of
 /// two (exactly) so the largest coordinate is about 1, Newell's sum in double-double. A
 /// component that might be zero is decided exactly (mirror-symmetric facets have exactly
@@ -173,13 +136,9 @@ PreciseNormal precise_given(const V3<ExactN>& normal) {
   for (int i = 0; i < 3; ++i) {
     const ExactN x = *components[i] * scale;
     if (CGAL::sign(x) == CGAL::ZERO) continue;  // exactly zero: hi = lo = error = 0
-    const double hi = x.to_double();            // within an ulp, not necessarily nearest
-    const DD s = quick_two_sum(hi, (x - ExactN(hi)).to_double());
-    // Mpzf's enclosure is built from its limbs, whatever the rounding mode.
-    const std::pair<double, double> rest = (x - ExactN(s.hi) - ExactN(s.lo)).to_interval();
+    const DD s = to_dd(x, n.error[i]);
     n.hi[i] = s.hi;
     n.lo[i] = s.lo;
-    n.error[i] = std::max(std::abs(rest.first), std::abs(rest.second));
   }
   n.valid = true;
   return n;
