@@ -842,6 +842,18 @@ HalfSpace make_halfspace(const V3<ExactN>& normal, const Exact& offset, int sour
   return {normal, integer_n(offset.numerator()), integer_n(offset.denominator()), source};
 }
 
+ExactN exact_difference(double a, double b) {
+  // One conversion instead of two and a subtraction: nearby vertices of a mesh (a facet's
+  // edges) almost always pass. 2 |b| may overflow to infinity or DBL_MAX, where the test
+  // still holds; a NaN fails it.
+  const double x = std::abs(a), y = std::abs(b);
+  if ((a < 0) == (b < 0) && x <= 2 * y && y <= 2 * x) return ExactN(a - b);
+  return ExactN(a) - ExactN(b);
+}
+V3<ExactN> exact_difference(const V3<double>& a, const V3<double>& b) {
+  return {exact_difference(a.x, b.x), exact_difference(a.y, b.y), exact_difference(a.z, b.z)};
+}
+
 namespace {
 
 /// A known point on all of the planes p[0 .. k), or -1.
@@ -1173,9 +1185,8 @@ KnownPoints erosion_points(const Polytope& A, const Polytope& B,
     RoundingGuard guard;
     for (int k = begin; k < end; ++k) {
       const auto [v, b] = creator[k];
-      const V3<ExactN> bn = to_exact_n(B.points[b]);
       if (A.exact_points.empty()) {
-        known.X[k] = to_exact_n(A.points[v]) - bn;
+        known.X[k] = exact_difference(A.points[v], B.points[b]);
         known.W[k] = ExactN(1);
         // The difference of two doubles, enclosed by rounding it both ways (no conversion
         // back from Mpzf).
@@ -1183,6 +1194,7 @@ KnownPoints erosion_points(const Polytope& A, const Polytope& B,
         known.Wi[k] = Interval(1);
       } else {
         const ExactN& w = A.exact_points.denominator[v];
+        const V3<ExactN> bn = to_exact_n(B.points[b]);
         known.X[k] =
             A.exact_points.numerator[v] - (w == 1 ? bn : V3<ExactN>{bn.x * w, bn.y * w, bn.z * w});
         known.W[k] = w;
@@ -1221,16 +1233,15 @@ MaybePolytope erode(const Polytope& A, const Polytope& B, const IntersectOptions
         // A triangle of double points (A's are then all doubles) and an element of double
         // points: its Newell normal is (q - p) x (r - p), the same value in fewer products,
         // its corners lie exactly on that plane, and h_A - h_B = <n, p - b> in one dot
-        // product, p's conversion shared with the normal's.
-        const V3<ExactN> p = to_exact_n(A.points[A.corner(f, 0)]);
-        h.normal = cross(to_exact_n(A.points[A.corner(f, 1)]) - p,
-                         to_exact_n(A.points[A.corner(f, 2)]) - p);
-        const V3<ExactN> bn = to_exact_n(B.points[b]);
-        h.offset = dot(h.normal, p - bn);
+        // product; differences of doubles as exact_difference.
+        const V3<double>& p = A.points[A.corner(f, 0)];
+        h.normal = cross(exact_difference(A.points[A.corner(f, 1)], p),
+                         exact_difference(A.points[A.corner(f, 2)], p));
+        h.offset = dot(h.normal, exact_difference(p, B.points[b]));
         on[0] = on[1] = on[2] = 1;
         // Another candidate c attains h_B iff <n, c - b> = 0.
         for (int c : candidates)
-          if (c != b && CGAL::sign(dot(h.normal, to_exact_n(B.points[c]) - bn)) == 0)
+          if (c != b && CGAL::sign(dot(h.normal, exact_difference(B.points[c], B.points[b]))) == 0)
             others[f].push_back(c);
         continue;
       }
