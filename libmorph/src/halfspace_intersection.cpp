@@ -1259,9 +1259,9 @@ MaybePolytope erode(const Polytope& A, const Polytope& B, const IntersectOptions
         dots.clear();
         for (int k = 0; k < A.degree(f); ++k) {
           dots.push_back(homogeneous_dot(A, n, A.corner(f, k)));
-          if (compare(dots[k], dots[best]) > 0) best = k;
+          if (k > 0 && compare(dots[k], dots[best]) > 0) best = k;
         }
-        for (int k = 0; k < A.degree(f); ++k) on[k] = same(dots[k], dots[best]);
+        for (int k = 0; k < A.degree(f); ++k) on[k] = k == best || same(dots[k], dots[best]);
       }
       const Homogeneous& top = dots[best];
       // h_A - h_B = (p V - q W) / (W V) for h_A = p / W, h_B = q / V.
