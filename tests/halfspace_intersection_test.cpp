@@ -12,7 +12,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
+#include <optional>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -638,4 +641,54 @@ TEST_CASE("halfspace_intersection: vertices on rounding midpoints round to even"
       CHECK(r.polytope->num_vertices() == 10);
     }
   }
+}
+
+// exact_difference takes the double difference only where Sterbenz makes it exact: compared
+// with the Mpzf subtraction on nearby, distant, opposite-signed, zero, subnormal, huge and
+// tiny pairs, and in the upward rounding of the interval filters.
+TEST_CASE("halfspace_intersection: exact differences of doubles") {
+  std::vector<double> values = {0.0,
+                                -0.0,
+                                1.0,
+                                -1.0,
+                                2.0,
+                                0.5,
+                                std::nextafter(2.0, 3.0),
+                                std::nextafter(0.5, 0.0),
+                                1e6 + 0.1,
+                                -3e5,
+                                0x1p200,
+                                std::nextafter(0x1p201, 0.0),
+                                0x1p-200,
+                                0x1p-1074,
+                                0x1p-1073,
+                                0x1p-1022,
+                                std::numeric_limits<double>::max(),
+                                std::nextafter(std::numeric_limits<double>::max(), 0.0),
+                                std::numeric_limits<double>::max() / 2};
+  std::mt19937_64 rng(5);
+  for (int i = 0; i < 200; ++i) {
+    const double x = std::ldexp(std::uniform_real_distribution<double>(-1, 1)(rng),
+                                std::uniform_int_distribution<int>(-1000, 1000)(rng));
+    values.push_back(x);
+    values.push_back(std::nextafter(x, 0.0) * (1 + 0x1p-30));
+    values.push_back(x * 1.999999999);
+    values.push_back(x * 0.5);
+  }
+  int wrong = 0, sterbenz = 0;
+  for (const bool upward : {false, true}) {
+    std::optional<RoundingGuard> guard;
+    if (upward) guard.emplace();
+    for (double a : values)
+      for (double b : values) {
+        const ExactN d = exact_difference(a, b);
+        wrong += !(d == ExactN(a) - ExactN(b));
+        sterbenz += d == ExactN(a - b);
+      }
+  }
+  CHECK(wrong == 0);
+  CHECK(sterbenz > 0);
+  const V3<ExactN> v = exact_difference(V3<double>{1, 0x1p-1074, -1e300}, V3<double>{3, 1, 1e300});
+  CHECK((v.x == ExactN(-2) && v.y == ExactN(0x1p-1074) - ExactN(1) &&
+         v.z == ExactN(-1e300) - ExactN(1e300)));
 }

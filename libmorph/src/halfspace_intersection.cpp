@@ -1173,6 +1173,18 @@ HalfSpace make_halfspace(const V3<ExactN>& normal, const Exact& offset, int sour
   return {normal, integer_n(offset.numerator()), integer_n(offset.denominator()), source};
 }
 
+ExactN exact_difference(double a, double b) {
+  // One conversion instead of two and a subtraction: nearby vertices of a mesh (a facet's
+  // edges) almost always pass. 2 |b| may overflow to infinity or DBL_MAX, where the test
+  // still holds; a NaN fails it.
+  const double x = std::abs(a), y = std::abs(b);
+  if ((a < 0) == (b < 0) && x <= 2 * y && y <= 2 * x) return ExactN(a - b);
+  return ExactN(a) - ExactN(b);
+}
+V3<ExactN> exact_difference(const V3<double>& a, const V3<double>& b) {
+  return {exact_difference(a.x, b.x), exact_difference(a.y, b.y), exact_difference(a.z, b.z)};
+}
+
 namespace {
 
 /// A known point on all of the planes p[0 .. k), or -1.
@@ -1296,26 +1308,33 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const KnownPoints
   });
   if (!ok) return {};
   // Directed edges 3 t + k (corner k to k + 1 of triangle t) listed by their first plane
-  // (a counting sort): each edge's reverse is the one edge back among the few leaving its
-  // second plane.
-  std::vector<int> out_begin(planes.size() + 1, 0), out_edge(3 * static_cast<std::size_t>(nt));
+  // (a counting sort), each with its second plane: each edge's reverse is the one edge back
+  // among the few leaving its second plane.
+  const auto next_corner = [](int k) { return k == 2 ? 0 : k + 1; };
+  std::vector<int> out_begin(planes.size() + 1, 0), out_edge(3 * static_cast<std::size_t>(nt)),
+      out_head(out_edge.size());
   for (const auto& c : s.corner)
     for (int a : c) ++out_begin[a + 1];
   std::partial_sum(out_begin.begin(), out_begin.end(), out_begin.begin());
   {
     std::vector<int> next(out_begin.begin(), out_begin.end() - 1);
-    for (int e = 0; e < 3 * nt; ++e) out_edge[next[s.corner[e / 3][e % 3]]++] = e;
+    for (int t = 0; t < nt; ++t)
+      for (int k = 0; k < 3; ++k) {
+        const int j = next[s.corner[t][k]]++;
+        out_edge[j] = 3 * t + k;
+        out_head[j] = s.corner[t][next_corner(k)];
+      }
   }
-  const auto head = [&](int e) { return s.corner[e / 3][(e % 3 + 1) % 3]; };
   s.across.resize(nt);
-  for (int e = 0; e < 3 * nt; ++e) {
-    const int a = s.corner[e / 3][e % 3], b = head(e);
-    int back = -1, found = 0;
-    for (int j = out_begin[b]; j < out_begin[b + 1]; ++j)
-      if (head(out_edge[j]) == a) back = out_edge[j], ++found;
-    if (found != 1) return {};  // an open surface, or an edge used twice
-    s.across[e / 3][e % 3] = back / 3;
-  }
+  for (int t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k) {
+      const int a = s.corner[t][k], b = s.corner[t][next_corner(k)];
+      int back = -1, found = 0;
+      for (int j = out_begin[b]; j < out_begin[b + 1]; ++j)
+        if (out_head[j] == a) back = out_edge[j], ++found;
+      if (found != 1) return {};  // an open surface, or an edge used twice
+      s.across[t][k] = back / 3;
+    }
   return s;
 }
 
@@ -1497,18 +1516,22 @@ KnownPoints erosion_points(const Polytope& A, const Polytope& B,
     RoundingGuard guard;
     for (int k = begin; k < end; ++k) {
       const auto [v, b] = creator[k];
-      const V3<ExactN> bn = to_exact_n(B.points[b]);
       if (A.exact_points.empty()) {
-        known.X[k] = to_exact_n(A.points[v]) - bn;
+        known.X[k] = exact_difference(A.points[v], B.points[b]);
         known.W[k] = ExactN(1);
+        // The difference of two doubles, enclosed by rounding it both ways (no conversion
+        // back from Mpzf).
+        known.Xi[k] = to_interval(A.points[v]) - to_interval(B.points[b]);
+        known.Wi[k] = Interval(1);
       } else {
         const ExactN& w = A.exact_points.denominator[v];
+        const V3<ExactN> bn = to_exact_n(B.points[b]);
         known.X[k] =
             A.exact_points.numerator[v] - (w == 1 ? bn : V3<ExactN>{bn.x * w, bn.y * w, bn.z * w});
         known.W[k] = w;
+        known.Xi[k] = to_interval_n(known.X[k]);
+        known.Wi[k] = to_interval_n(known.W[k]);
       }
-      known.Xi[k] = to_interval_n(known.X[k]);
-      known.Wi[k] = to_interval_n(known.W[k]);
     }
   });
   return known;
@@ -1530,15 +1553,35 @@ MaybePolytope erode(const Polytope& A, const Polytope& B, const IntersectOptions
     std::vector<Homogeneous> dots;
     std::vector<int> candidates;
     for (int f = begin; f < end; ++f) {
-      // A triangle's Newell normal is (q - p) x (r - p), the same value in fewer products.
+      const int b = location_vertex(B, loc[f]);
+      contributing[f] = b;
+      candidate_vertices(B, loc[f], candidates);
+      char* on = &on_plane[A.face_begin[f]];
+      HalfSpace& h = hs[f];
+      h.source = A.face_source[f];
+      h.element = B.vertex_source[b];
+      if (A.degree(f) == 3 && A.given_normals.empty() && B.exact_points.empty()) {
+        // A triangle of double points (A's are then all doubles) and an element of double
+        // points: its Newell normal is (q - p) x (r - p), the same value in fewer products,
+        // its corners lie exactly on that plane, and h_A - h_B = <n, p - b> in one dot
+        // product; differences of doubles as exact_difference.
+        const V3<double>& p = A.points[A.corner(f, 0)];
+        h.normal = cross(exact_difference(A.points[A.corner(f, 1)], p),
+                         exact_difference(A.points[A.corner(f, 2)], p));
+        h.offset = dot(h.normal, exact_difference(p, B.points[b]));
+        on[0] = on[1] = on[2] = 1;
+        // Another candidate c attains h_B iff <n, c - b> = 0.
+        for (int c : candidates)
+          if (c != b && CGAL::sign(dot(h.normal, exact_difference(B.points[c], B.points[b]))) == 0)
+            others[f].push_back(c);
+        continue;
+      }
       const V3<ExactN> n =
           A.degree(f) == 3 && A.given_normals.empty() ? triangle_normal(A, f) : A.exact_normal(f);
-      const int b = location_vertex(B, loc[f]);
       // h_A(N_f) = max over f's corners of <n, X> / W, compared by cross-multiplication
       // (W > 0; W = 1 for double points, and for the exact sums of a closing): no
       // rationals, no gcd. A triangle of double points holds its corners exactly on the
       // plane of its Newell normal.
-      char* on = &on_plane[A.face_begin[f]];
       int best = 0;
       if (A.degree(f) == 3 && A.given_normals.empty()) {
         dots.assign(1, homogeneous_dot(A, n, A.corner(f, 0)));
@@ -1547,19 +1590,16 @@ MaybePolytope erode(const Polytope& A, const Polytope& B, const IntersectOptions
         dots.clear();
         for (int k = 0; k < A.degree(f); ++k) {
           dots.push_back(homogeneous_dot(A, n, A.corner(f, k)));
-          if (compare(dots[k], dots[best]) > 0) best = k;
+          if (k > 0 && compare(dots[k], dots[best]) > 0) best = k;
         }
-        for (int k = 0; k < A.degree(f); ++k) on[k] = same(dots[k], dots[best]);
+        for (int k = 0; k < A.degree(f); ++k) on[k] = k == best || same(dots[k], dots[best]);
       }
       const Homogeneous& top = dots[best];
       // h_A - h_B = (p V - q W) / (W V) for h_A = p / W, h_B = q / V.
       const Homogeneous hb = homogeneous_dot(B, n, b);
-      contributing[f] = b;
-      candidate_vertices(B, loc[f], candidates);
       for (int c : candidates) {
         if (c != b && same(homogeneous_dot(B, n, c), hb)) others[f].push_back(c);
       }
-      HalfSpace& h = hs[f];
       h.normal = n;
       if (top.weight == 1 && hb.weight == 1) {
         h.offset = top.value - hb.value;
@@ -1567,8 +1607,6 @@ MaybePolytope erode(const Polytope& A, const Polytope& B, const IntersectOptions
         h.offset = top.value * hb.weight - hb.value * top.weight;
         h.denominator = top.weight * hb.weight;
       }
-      h.source = A.face_source[f];
-      h.element = B.vertex_source[b];
     }
   });
   const KnownPoints known = erosion_points(A, B, contributing, others, on_plane, sum_of_b);
