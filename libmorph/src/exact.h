@@ -125,6 +125,20 @@ inline DD to_dd(const ExactN& x, double& error) {
   return quick_two_sum(hi, rest.first);
 }
 
+/// a - b exactly: the double difference when it is exact (Sterbenz: same signs and within a
+/// factor 2 of each other, in any rounding mode), else the Mpzf subtraction.
+inline ExactN exact_difference(double a, double b) {
+  // One conversion instead of two and a subtraction: nearby vertices of a mesh (a facet's
+  // edges) almost always pass. 2 |b| may overflow to infinity or DBL_MAX, where the test
+  // still holds; a NaN fails it.
+  const double x = std::abs(a), y = std::abs(b);
+  if ((a < 0) == (b < 0) && x <= 2 * y && y <= 2 * x) return ExactN(a - b);
+  return ExactN(a) - ExactN(b);
+}
+inline V3<ExactN> exact_difference(const V3<double>& a, const V3<double>& b) {
+  return {exact_difference(a.x, b.x), exact_difference(a.y, b.y), exact_difference(a.z, b.z)};
+}
+
 /// Sign of an interval, or 2 when it straddles zero (undecided).
 inline int interval_sign(const Interval& v) {
   if (v.inf() > 0) return 1;

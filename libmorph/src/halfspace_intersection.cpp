@@ -1173,18 +1173,6 @@ HalfSpace make_halfspace(const V3<ExactN>& normal, const Exact& offset, int sour
   return {normal, integer_n(offset.numerator()), integer_n(offset.denominator()), source};
 }
 
-ExactN exact_difference(double a, double b) {
-  // One conversion instead of two and a subtraction: nearby vertices of a mesh (a facet's
-  // edges) almost always pass. 2 |b| may overflow to infinity or DBL_MAX, where the test
-  // still holds; a NaN fails it.
-  const double x = std::abs(a), y = std::abs(b);
-  if ((a < 0) == (b < 0) && x <= 2 * y && y <= 2 * x) return ExactN(a - b);
-  return ExactN(a) - ExactN(b);
-}
-V3<ExactN> exact_difference(const V3<double>& a, const V3<double>& b) {
-  return {exact_difference(a.x, b.x), exact_difference(a.y, b.y), exact_difference(a.z, b.z)};
-}
-
 namespace {
 
 /// A known point on all of the planes p[0 .. k), or -1.

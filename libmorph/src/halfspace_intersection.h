@@ -28,11 +28,6 @@ struct HalfSpace {
 /// The half-space <normal, x> <= offset for any rational offset.
 HalfSpace make_halfspace(const V3<ExactN>& normal, const Exact& offset, int source);
 
-/// a - b exactly: the double difference when it is exact (Sterbenz: same signs and within a
-/// factor 2 of each other, in any rounding mode), else the Mpzf subtraction.
-ExactN exact_difference(double a, double b);
-V3<ExactN> exact_difference(const V3<double>& a, const V3<double>& b);
-
 /// Which hull gave an intersection (for tests and profiling).
 enum class HullRoute : unsigned char {
   none,         // empty or flat: no hull
