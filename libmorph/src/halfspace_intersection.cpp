@@ -1205,16 +1205,18 @@ constexpr int kFlipsPerCorner = 4;
 /// left as it is: the builder groups such triangles). Each flip makes the surface more
 /// convex, so flips stop for dual points in convex position (nearly coplanar ones, such as
 /// the moved facets around a vertex of A). Writes k - 2 triangles to `out`; false when a
-/// triangle is not positively oriented or the flips take more than kFlipsPerCorner k (the
+/// triangle is not positively oriented, the flips take more than kFlipsPerCorner k (the
 /// guess is then likely wrong, and the hull is computed; a triangle never tested is left to
-/// the check). Needs a RoundingGuard.
+/// the check), or the polygon would split and `split` is false (ExpectedVertices::split).
+/// Needs a RoundingGuard.
 bool triangulate_polygon(const std::vector<Plane>& planes, const KnownPoints& known, const int* p,
-                         int k, std::array<int, 3>* out, PolygonScratch& scratch) {
+                         int k, bool split, std::array<int, 3>* out, PolygonScratch& scratch) {
   // Planes through one known point (facets of A moved by one vertex of B): one vertex.
   if (k == 3 || common_point(known, p, k) >= 0) {
     for (int i = 1; i + 1 < k; ++i) out[i - 1] = {p[0], p[i], p[i + 1]};
     return true;
   }
+  if (!split) return false;
   auto& triangle = scratch.triangle;
   auto& vertex = scratch.vertex;
   auto& ready = scratch.ready;
@@ -1290,8 +1292,8 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const KnownPoints
     PolygonScratch scratch;
     for (int v = begin; v < end && ok; ++v)
       if (!triangulate_polygon(planes, known, &expected.facets[expected.begin[v]],
-                               expected.begin[v + 1] - expected.begin[v], &s.corner[first[v]],
-                               scratch))
+                               expected.begin[v + 1] - expected.begin[v], expected.split,
+                               &s.corner[first[v]], scratch))
         ok = false;
   });
   if (!ok) return {};
@@ -1625,6 +1627,7 @@ MaybePolytope erode_sum(const Polytope& S, const Polytope& A, const Polytope& B,
   ExpectedVertices expected;
   if (std::find(facet_of.begin(), facet_of.end(), -1) == facet_of.end()) {
     expected.begin = A.fan_begin;
+    expected.split = false;
     expected.facets.reserve(A.fan_face.size());
     for (int f : A.fan_face) expected.facets.push_back(facet_of[f]);
   }

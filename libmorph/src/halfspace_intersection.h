@@ -102,6 +102,10 @@ struct KnownPoints {
 struct ExpectedVertices {
   std::vector<int> begin;  // size V + 1, or empty
   std::vector<int> facets;
+  // false: each polygon is expected to be one vertex of the result, its planes through one
+  // known point (a closing's A); a polygon that is not gives the guess up at once (A's
+  // facets only nearly planar: the result is not A, and flips would not find it either).
+  bool split = true;
   bool empty() const { return begin.empty(); }
 };
 
