@@ -60,16 +60,6 @@ struct Connectivity {
 constexpr int kFacetGrain = 512;
 constexpr int kCornerGrain = 2048;
 
-/// parallel_chunks, but a plain loop when the arena has one thread: each of these passes
-/// is short, and a TBB loop costs a few microseconds even with nothing to share.
-template <class Body>
-void parallel_pass(int n, int grain, const Body& body) {
-  if (tbb::this_task_arena::max_concurrency() > 1)
-    parallel_chunks(n, grain, body);
-  else if (n > 0)
-    body(0, n);
-}
-
 /// The facet, next and previous corner of every corner (no twins yet).
 Connectivity facet_cycles(const Soup& soup) {
   const int nc = static_cast<int>(soup.vertex.size());
@@ -77,7 +67,7 @@ Connectivity facet_cycles(const Soup& soup) {
   k.face.resize(nc);
   k.next.resize(nc);
   k.prev.resize(nc);
-  parallel_pass(soup.size(), kFacetGrain, [&](int first, int last) {
+  parallel_chunks(soup.size(), kFacetGrain, [&](int first, int last) {
     for (int f = first; f < last; ++f) {
       const int b = soup.begin[f], e = soup.begin[f + 1];
       if (b == e) continue;
@@ -251,7 +241,7 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
                     bool& changed) {
   const int nf = soup.size();
   std::vector<FacetGeometry> geo(nf);
-  parallel_pass(nf, kFacetGrain, [&](int first, int last) {
+  parallel_chunks(nf, kFacetGrain, [&](int first, int last) {
     for (int f = first; f < last; ++f) geo[f] = geometry(points, soup, f);
   });
   const Groups groups = group_coplanar(points, soup, k, geo, limit);
@@ -265,7 +255,7 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
       }
   const int nc = static_cast<int>(soup.vertex.size());
   std::vector<int> corner_group(nc);  // looked up several times per corner below
-  parallel_pass(nc, kCornerGrain, [&](int first, int last) {
+  parallel_chunks(nc, kCornerGrain, [&](int first, int last) {
     for (int c = first; c < last; ++c) corner_group[c] = groups.of[k.face[c]];
   });
   const auto group = [&](int c) { return corner_group[c]; };
@@ -364,7 +354,7 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
   // Each polygon's corner test, against the plane of its group's largest facet (the group
   // of the corners its chains cover): independent, so in parallel, after the walks.
   std::atomic<bool> convex{true};
-  parallel_pass(out.size(), kFacetGrain, [&](int first, int last) {
+  parallel_chunks(out.size(), kFacetGrain, [&](int first, int last) {
     for (int m = first; m < last && convex.load(std::memory_order_relaxed); ++m) {
       const int b = out.begin[m];
       const V3<double>& normal = geo[largest[group(chain_end[b])]].normal;
@@ -391,7 +381,7 @@ std::optional<Connectivity> connect_with(int num_points, const Soup& soup,
   Connectivity k = facet_cycles(soup);
   k.twin = std::move(twin);
   std::atomic<bool> reverse{true};
-  parallel_pass(nc, kCornerGrain, [&](int first, int last) {
+  parallel_chunks(nc, kCornerGrain, [&](int first, int last) {
     for (int c = first; c < last; ++c) {
       const int t = k.twin[c];
       if (t < 0 || t >= nc || t == c || k.twin[t] != c ||
@@ -481,7 +471,7 @@ Mesh build(const std::vector<V3<double>>& points, const Soup& soup, const Connec
     }
   }
   // Faces write their own halfedges only: in parallel.
-  parallel_pass(soup.size(), kFacetGrain, [&](int first, int last) {
+  parallel_chunks(soup.size(), kFacetGrain, [&](int first, int last) {
     for (int f = first; f < last; ++f) {
       const Mesh::FaceHandle fh(f);
       const int b = soup.begin[f], e = soup.begin[f + 1];
@@ -644,7 +634,7 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
   // The facets with close corners (few), found in parallel; their unions follow in order.
   std::vector<char> has_close(nf, 0);
   std::atomic<bool> any_close{false};
-  parallel_pass(nf, kFacetGrain, [&](int first, int last) {
+  parallel_chunks(nf, kFacetGrain, [&](int first, int last) {
     bool found = false;
     for (int f = first; f < last; ++f) {
       bool here = false;

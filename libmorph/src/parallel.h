@@ -36,10 +36,11 @@ auto run_with_threads(int threads, F&& f) {
 }
 
 /// Calls body(begin, end) over [0, n) in chunks of about `grain`, in parallel when n is
-/// large enough to pay for it.
+/// large enough to pay for it and the arena has more than one thread (a TBB loop costs a
+/// few microseconds even with nothing to share; one thread calls body(0, n) directly).
 template <class Body>
 void parallel_chunks(int n, int grain, const Body& body) {
-  if (n <= grain) {
+  if (n <= grain || tbb::this_task_arena::max_concurrency() == 1) {
     if (n > 0) body(0, n);
     return;
   }
