@@ -683,7 +683,8 @@ TEST_CASE("halfspace_intersection: exact differences of doubles") {
       for (double b : values) {
         const ExactN d = exact_difference(a, b);
         wrong += !(d == ExactN(a) - ExactN(b));
-        sterbenz += d == ExactN(a - b);
+        const double rounded = a - b;  // overflows for DBL_MAX - (-DBL_MAX): no Mpzf of it
+        sterbenz += std::isfinite(rounded) && d == ExactN(rounded);
       }
   }
   CHECK(wrong == 0);
