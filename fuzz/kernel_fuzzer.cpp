@@ -185,7 +185,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         require_inside(va, vb, planes_s, tolerance, "A + b inside A (+) B");
         break;
       case 2:
-        require_inside(vs, {}, planes_a, tolerance, "erosion inside A");
+        // x + B inside A for every x of the erosion (not x itself: B need not hold the origin,
+        // and A (-) {b} is A - b).
         require_inside(vs, vb, planes_a, tolerance, "erosion + b inside A");
         break;
       case 3:

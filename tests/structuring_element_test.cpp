@@ -285,8 +285,22 @@ TEST_CASE("se: every bad spec is an input_error listing the valid forms") {
                            "dodecahedron:r=1e-200",
                            "torus:1,0.5",
                            "sphere=1",
-                           "icosahedron:r=1e300"})
+                           "icosahedron:r=1e300",
+                           "cylinder:r=1,h=288888888888888888888888888888,n=8",
+                           "box:1,1e6,1e-6"})
     check_bad_spec(spec);
+}
+
+// Extents within their bounds but proportions beyond double precision (found by the fuzzer):
+// refused as a spec, with the reason, rather than built into a mesh validation rejects.
+TEST_CASE("se: an element too thin to be a solid in doubles is a bad spec") {
+  try {
+    (void)morph::make_structuring_element("cylinder:r=1,h=1e30,n=8");
+    FAIL("accepted");
+  } catch (const morph::input_error& e) {
+    CHECK(std::string(e.what()).find("proportions are too extreme") != std::string::npos);
+  }
+  CHECK(morph::make_structuring_element("cylinder:r=1,h=1e6,n=8").n_faces() == 10);
 }
 
 TEST_CASE("se: a spec naming a file reads and checks the mesh") {

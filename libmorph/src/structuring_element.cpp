@@ -303,11 +303,20 @@ Mesh make_structuring_element(std::string_view spec) {
   };
   // Parameter errors (a negative radius) are reported with the spec and the grammar.
   const auto build = [&](auto&& make) -> Mesh {
-    try {
-      return make();
-    } catch (const input_error& error) {
-      bad_spec(spec, error.what());
-    }
+    Mesh mesh = [&] {
+      try {
+        return make();
+      } catch (const input_error& error) {
+        bad_spec(spec, error.what());
+      }
+    }();
+    // Each extent is bounded on its own; their ratio can still be beyond what doubles
+    // resolve (cylinder:r=1,h=1e30: its caps have no area at the element's scale). Such an
+    // element is refused here, as a bad spec, not later as a bad operand.
+    if (const CheckResult check = check_convex_polyhedron(mesh); !check.ok())
+      bad_spec(spec, "its proportions are too extreme for a valid solid in double precision (" +
+                         check.problem + ")");
+    return mesh;
   };
   if (kind == "sphere") {
     const auto v = values({{"r", {}}, {"level", 2.0, true}});
