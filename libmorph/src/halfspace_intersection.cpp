@@ -1396,8 +1396,9 @@ Homogeneous homogeneous_dot(const Polytope& P, const V3<ExactN>& n, int v) {
 }
 /// The Newell normal of triangle f of a polytope with double points.
 V3<ExactN> triangle_normal(const Polytope& A, int f) {
-  const V3<ExactN> p = to_exact_n(A.points[A.corner(f, 0)]);
-  return cross(to_exact_n(A.points[A.corner(f, 1)]) - p, to_exact_n(A.points[A.corner(f, 2)]) - p);
+  const V3<double>& p = A.points[A.corner(f, 0)];
+  return cross(exact_difference(A.points[A.corner(f, 1)], p),
+               exact_difference(A.points[A.corner(f, 2)], p));
 }
 /// Sign of p - q, by cross-multiplication unless both weights are 1.
 int compare(const Homogeneous& p, const Homogeneous& q) {
@@ -1555,10 +1556,8 @@ MaybePolytope erode(const Polytope& A, const Polytope& B, const IntersectOptions
         // points: its Newell normal is (q - p) x (r - p), the same value in fewer products,
         // its corners lie exactly on that plane, and h_A - h_B = <n, p - b> in one dot
         // product; differences of doubles as exact_difference.
-        const V3<double>& p = A.points[A.corner(f, 0)];
-        h.normal = cross(exact_difference(A.points[A.corner(f, 1)], p),
-                         exact_difference(A.points[A.corner(f, 2)], p));
-        h.offset = dot(h.normal, exact_difference(p, B.points[b]));
+        h.normal = triangle_normal(A, f);
+        h.offset = dot(h.normal, exact_difference(A.points[A.corner(f, 0)], B.points[b]));
         on[0] = on[1] = on[2] = 1;
         // Another candidate c attains h_B iff <n, c - b> = 0.
         for (int c : candidates)
