@@ -2,6 +2,7 @@
 // way: the expected verdict comes from the construction, not from an earlier run.
 #include <doctest/doctest.h>
 #include <morph/error.h>
+#include <morph/io.h>
 #include <morph/structuring_element.h>
 #include <morph/validate.h>
 
@@ -314,4 +315,64 @@ TEST_CASE("validate: a 327,680-triangle icosphere passes and its volume approach
   const double volume = morph::signed_volume(sphere);
   CHECK(volume < 4.0 / 3.0 * M_PI);
   CHECK(volume > 4.0 / 3.0 * M_PI * (1 - 1e-4));
+}
+
+// Triangles take a shortcut through the geometric checks (validate.cpp, triangle_passes):
+// the general path's arithmetic unrolled. Its verdicts and messages must be the general
+// path's, to the last bit of every height: the expected messages below are what the
+// general path gave for every face before the shortcut existed. The planarity tolerances
+// are tiny on purpose, so that rounding-level heights decide which face is named first.
+TEST_CASE("validate: triangle faces keep the general path's verdicts and messages") {
+  const auto problem = [](const Mesh& mesh, double tolerance = morph::kPlanarityTolerance) {
+    morph::ValidationOptions options;
+    options.planarity_tolerance = tolerance;
+    return morph::check_convex_polyhedron(mesh, options).problem;
+  };
+  SUBCASE("rejections of a triangle fall back to the general path's message") {
+    auto points = cube_points();
+    points[3] = Point(0.5, 0, 0);  // on the edge 0-1: triangle {0, 3, 1} is flat
+    CHECK(problem(mesh_of(points, cube_triangles())) ==
+          "face 1 has zero area (its vertices are collinear)");
+    points[3] = Point(1, 0, 0);  // on vertex 1
+    CHECK(problem(mesh_of(points, cube_triangles())) ==
+          "face 1 has two vertices at the same position");
+  }
+  SUBCASE("reflex edges between triangles, and between a triangle and quads") {
+    auto points = cube_points();
+    points[7] = Point(1, 1, 0.5);  // the top's diagonal 4-7 turns reflex; the sides stay planar
+    CHECK(problem(mesh_of(points, cube_triangles())) ==
+          "edge 7 (vertices 7-4) is reflex: vertex 6 of face 3 is 0.45 above the plane of face "
+          "2 (tolerance 1.7e-09)");
+    auto mixed = kCubeQuads;  // only the top split into triangles
+    mixed[1] = {4, 5, 7};
+    mixed.push_back({4, 7, 6});
+    CHECK(problem(mesh_of(points, mixed)) ==
+          "edge 6 (vertices 7-4) is reflex: vertex 6 of face 6 is 0.45 above the plane of face "
+          "1 (tolerance 1.7e-09)");
+  }
+  SUBCASE("the heights of nearly planar triangles, bit for bit") {
+    const auto sample = [](const char* name) {
+      return morph::read_mesh(std::string(MORPH_SAMPLES_DIR) + "/" + name);
+    };
+    const Mesh sphere = sample("icosphere_320.off");
+    CHECK(problem(sphere, 0) ==
+          "face 0 is not planar: vertex 0 is 3.5e-17 from its plane (tolerance 0)");
+    CHECK(problem(sphere, 1.0676581484615456e-17) ==
+          "face 1 is not planar: vertex 12 is 5.6e-17 from its plane (tolerance 3.7e-17)");
+    CHECK(problem(sphere, 2.9457025063071409e-17) ==
+          "face 5 is not planar: vertex 13 is 1.2e-16 from its plane (tolerance 1e-16)");
+    CHECK(problem(sample("icosphere_5120.off"), 5.7946426834533691e-17) ==
+          "face 92 is not planar: vertex 174 is 2.2e-16 from its plane (tolerance 2e-16)");
+    CHECK(problem(sample("random_hull_200.off"), 1.7144256780108083e-17) ==
+          "face 3 is not planar: vertex 0 is 8.3e-17 from its plane (tolerance 5.6e-17)");
+    // The fan volumes: an inverted sphere's signed volume is reported.
+    Mesh inverted;
+    for (const auto& v : sphere.vertices()) inverted.add_vertex(sphere.point(v));
+    for (const auto& f : sphere.faces()) {
+      std::vector<Mesh::VertexHandle> loop;
+      for (const auto& v : f.vertices()) loop.insert(loop.begin(), v);
+      inverted.add_face(loop);
+    }
+    CHECK(problem(inverted) == "the faces are oriented inwards (signed volume -4 < 0)");
+  }
 }

@@ -366,6 +366,97 @@ bool has_equal_pair(int n, const Key& key) {
   return false;
 }
 
+// A triangle's share of nondegenerate(), the usual case: the same operations in the same
+// order as newell_plane(), height(), FanVolumes::add_face() and reflex_across(), unrolled
+// into one place (the general path's loops and calls cost more than its arithmetic), so
+// every value and verdict is the general path's. Returns false, having changed nothing,
+// when the triangle fails one of the checks that reject a mesh: the general path then
+// names the problem.
+bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, double tolerance,
+                     double zero_area, bool convexity, Geometry& geometry) {
+  const int* ids = cycles.corners(f);
+  const int* across = cycles.across.data() + cycles.begin[f];
+  const int i0 = ids[0], i1 = ids[1], i2 = ids[2];
+  if (i0 == i1 || i0 == i2 || i1 == i2) return false;
+  const Point &p0 = m.points[i0], &p1 = m.points[i1], &p2 = m.points[i2];
+  // In plain doubles: OpenMesh's vector operations, one component at a time.
+  double c[3], normal[3];
+  for (int i = 0; i < 3; ++i) c[i] = (((0.0 + p0[i]) + p1[i]) + p2[i]) * (1.0 / 3);
+  double a[3][3];  // the corners relative to the centroid
+  for (int i = 0; i < 3; ++i) {
+    a[0][i] = p0[i] - c[i];
+    a[1][i] = p1[i] - c[i];
+    a[2][i] = p2[i] - c[i];
+  }
+  // cross(u, v) component i: u[j] v[l] - u[l] v[j] with (j, l) = (i + 1, i + 2) mod 3.
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3, l = (i + 2) % 3;
+    normal[i] = ((0.0 + (a[0][j] * a[1][l] - a[0][l] * a[1][j])) +
+                 (a[1][j] * a[2][l] - a[1][l] * a[2][j])) +
+                (a[2][j] * a[0][l] - a[2][l] * a[0][j]);
+  }
+  if (p0 == p1 || p0 == p2 || p1 == p2) return false;
+  const double length =
+      std::sqrt((normal[0] * normal[0] + normal[1] * normal[1]) + normal[2] * normal[2]);
+  if (!(length > zero_area)) return false;
+  const double inverse = 1.0 / length;
+  for (double& x : normal) x *= inverse;
+  {
+    const Point& o = geometry.extent.centre;
+    const double u[3] = {p2[0] - o[0], p2[1] - o[1], p2[2] - o[2]};
+    const double v[3] = {p0[0] - o[0], p0[1] - o[1], p0[2] - o[2]};
+    const double w[3] = {p1[0] - o[0], p1[1] - o[1], p1[2] - o[2]};
+    const double six_v = (u[0] * (v[1] * w[2] - v[2] * w[1]) + u[1] * (v[2] * w[0] - v[0] * w[2])) +
+                         u[2] * (v[0] * w[1] - v[1] * w[0]);
+    geometry.volumes.total += six_v;
+    geometry.volumes.absolute += std::abs(six_v);
+  }
+  // The points whose height above the plane the checks read: the corners (planarity),
+  // then the corner of each neighbouring triangle off the common edge (convexity).
+  const bool reflex = convexity && !geometry.reflex;
+  const Point* points[6] = {&p0, &p1, &p2};
+  int count = 3;
+  bool polygon_across = false;  // a neighbour is not a triangle: checked after
+  if (reflex) {
+    const int from[3] = {i2, i0, i1}, to[3] = {i0, i1, i2};
+    for (int k = 0; k < 3; ++k) {
+      const int g = across[k];
+      if (cycles.degree(g) != 3) {
+        polygon_across = true;
+        continue;
+      }
+      const int* corners = cycles.corners(g);
+      const int v = corners[0] != from[k] && corners[0] != to[k]   ? corners[0]
+                    : corners[1] != from[k] && corners[1] != to[k] ? corners[1]
+                                                                   : corners[2];
+      points[count++] = &m.points[v];
+    }
+  }
+  // height(plane, p): dot(p - centroid, normal), summed in OpenMesh's order.
+  const double nx = normal[0], ny = normal[1], nz = normal[2];
+  const double cx = c[0], cy = c[1], cz = c[2];
+  double height[6];
+  for (int k = 0; k < count; ++k) {
+    const Point& p = *points[k];
+    height[k] = (p[0] - cx) * nx + (p[1] - cy) * ny + (p[2] - cz) * nz;
+  }
+  if (geometry.non_planar_face < 0 &&
+      !(std::abs(height[0]) <= tolerance && std::abs(height[1]) <= tolerance &&
+        std::abs(height[2]) <= tolerance))
+    geometry.non_planar_face = f;
+  if (reflex) {
+    for (int k = 3; k < count; ++k) geometry.reflex = geometry.reflex || !(height[k] <= tolerance);
+    if (polygon_across && !geometry.reflex) {
+      const FacePlane plane{Point(cx, cy, cz), Point(nx, ny, nz)};
+      const int from[3] = {i2, i0, i1}, to[3] = {i0, i1, i2};
+      for (int k = 0; k < 3 && !geometry.reflex; ++k)
+        if (cycles.degree(across[k]) != 3)
+          geometry.reflex = reflex_across(m, cycles, plane, across[k], from[k], to[k], tolerance);
+    }
+  }
+  return true;
+}
+
 // Fills `geometry` for the later checks when the mesh passes; planarity is judged with
 // `relative_tolerance` times the bounding-box diagonal. With `convexity` (only for a closed
 // mesh), also whether any edge may be reflex, with each face's plane while it is at hand.
@@ -386,10 +477,13 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
                                       ", " + number(kMaxSize) + "]");
   const double tolerance = relative_tolerance * diagonal;
   geometry.cycles = face_cycles(m);
+  const double zero_area = kZeroAreaRatio * diagonal * diagonal;
   for (int f = 0; f < m.n_faces; ++f) {
     if (!m.live_face(f)) continue;
-    const int* ids = geometry.cycles.corners(f);
     const int n = geometry.cycles.degree(f);
+    if (n == 3 && triangle_passes(m, geometry.cycles, f, tolerance, zero_area, convexity, geometry))
+      continue;
+    const int* ids = geometry.cycles.corners(f);
     const auto face = [&] { return "face " + std::to_string(f); };
     if (n < 3)
       return fail(Verdict::invalid,
@@ -405,7 +499,7 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
     if (has_equal_pair(n, [&](int i) -> const Point& { return m.points[ids[i]]; }))
       return fail(Verdict::invalid, face() + " has two vertices at the same position");
     const double length = plane.normal.norm();
-    if (!(length > kZeroAreaRatio * diagonal * diagonal))
+    if (!(length > zero_area))
       return fail(Verdict::invalid, face() + " has zero area (its vertices are collinear)");
     plane.normal *= 1.0 / length;
     geometry.volumes.add_face(m.points, ids, n, geometry.extent.centre);
