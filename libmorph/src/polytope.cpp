@@ -458,7 +458,7 @@ int triangle_edge_convexity(const Polytope& p, const Polytope::Edge& e) {
 /// 1) and d' within r of d = to - from: |det(a', b', d') - det(a, b, d)| <= (e_a + e_b)
 /// |d'| + r, and the evaluation adds at most kUnitPredicateRounding |d'| (the unit bound,
 /// scaled); any rounding mode.
-int unit_edge_convexity(const Polytope& p, const Polytope::Edge& e) {
+inline int unit_edge_convexity(const Polytope& p, const Polytope::Edge& e) {
   const UnitNormal &a = p.unit_normals[e.left], &b = p.unit_normals[e.right];
   V3<double> d;
   double radius;
@@ -508,14 +508,24 @@ int edge_convexity(const Polytope& p, const Polytope::Edge& e) {
 /// counter-clockwise (a convex spherical polygon).
 void check_gauss_map(const Polytope& p, const char* name) {
   // orient_normals works in any rounding mode: no RoundingGuard.
+  const UnitNormal* unit = p.unit_normals.data();
   for (int v = 0; v < p.num_vertices(); ++v) {
     const int b = p.fan_begin[v], n = p.fan_begin[v + 1] - b;
     if (n < 3)
       fail(name, "vertex " + std::to_string(p.vertex_source[v]) + " has fewer than three facets");
+    const int* fan = &p.fan_face[b];
     for (int i = 0, j = 1, k = 2; i < n; ++i, j = k, k = k + 1 == n ? 0 : k + 1) {
-      const int s =
-          orient_normals(NormalRef{&p, p.fan_face[b + i]}, NormalRef{&p, p.fan_face[b + j]},
-                         NormalRef{&p, p.fan_face[b + k]});
+      // orient_normals' double filter, on the unit normals read straight from the array
+      // (the same expression and bound); its later stages decide what it leaves.
+      const UnitNormal &x = unit[fan[i]], &y = unit[fan[j]], &z = unit[fan[k]];
+      const double d = x.x * (y.y * z.z - y.z * z.y) + x.y * (y.z * z.x - y.x * z.z) +
+                       x.z * (y.x * z.y - y.y * z.x);
+      const double bound = x.error + y.error + z.error + kUnitPredicateRounding;
+      if (d > bound) continue;
+      const int s = d < -bound
+                        ? -1
+                        : orient_normals_undecided(NormalRef{&p, fan[i]}, NormalRef{&p, fan[j]},
+                                                   NormalRef{&p, fan[k]});
       if (s <= 0)
         fail(name, "the facets around vertex " + std::to_string(p.vertex_source[v]) +
                        " do not turn convexly (the mesh is not convex)");
@@ -537,8 +547,11 @@ bool is_canonical(const Polytope& p) {
   for (int v = 0; v < p.num_vertices(); ++v)
     if (p.fan_begin[v + 1] - p.fan_begin[v] < 3) return false;
   RoundingGuard guard;
-  for (const auto& e : p.edges)
-    if (edge_convexity(p, e) <= 0) return false;
+  for (const auto& e : p.edges) {
+    // edge_convexity's first stage here, so that only what it leaves costs a call.
+    const int s = unit_edge_convexity(p, e);
+    if (s < 0 || (s == 2 && edge_convexity(p, e) <= 0)) return false;
+  }
   return true;
 }
 
@@ -596,28 +609,29 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   // stores the two halfedges of edge e as 2e and 2e + 1). Its vertex is the other end of
   // c's edge, in either order.
   auto twin = [&](int k) { return corner_of[corner_halfedge[k] ^ 1]; };
-  // Edges in order of first use: an edge is first used by the smaller of its two corners.
+  // One pass over the corners: edges in order of first use (an edge is first used by the
+  // smaller of its two corners), the fan links (from the last corner at v, the next facet
+  // counter-clockwise is across the incoming edge u -> v, at corner twin(prev corner),
+  // precomputed so that the fan walk below follows one link per step, as
+  // build_connectivity walks them) and the last corner at each vertex, where its fan starts.
   std::vector<int> mesh_edge;
   mesh_edge.reserve(mesh.n_edges());
   p.edges.clear();
   p.edges.reserve(mesh.n_edges());
   p.corner_edge.resize(nc);
+  std::vector<int> some_corner(nv, -1);
   for (c = 0; c < nc; ++c) {
+    FanLink& l = link[c];
+    l.next = twin(l.prev);
+    some_corner[p.corner_vertex[c]] = c;
     const int t = twin(c);
     if (t < c) continue;  // numbered at t
     const int e = static_cast<int>(p.edges.size());
-    p.edges.push_back({p.corner_vertex[c], p.corner_vertex[t], link[c].face, link[t].face});
+    p.edges.push_back({p.corner_vertex[c], p.corner_vertex[t], l.face, link[t].face});
     mesh_edge.push_back(corner_halfedge[c] >> 1);
     p.corner_edge[c] = e;
     p.corner_edge[t] = e;
   }
-
-  // Fans, walked as build_connectivity does: from the last corner at v, the next facet
-  // counter-clockwise is across the incoming edge u -> v, at corner twin(prev corner);
-  // precomputed so that the walk follows one link per step.
-  for (c = 0; c < nc; ++c) link[c].next = twin(link[c].prev);
-  std::vector<int> some_corner(nv, -1);
-  for (c = 0; c < nc; ++c) some_corner[p.corner_vertex[c]] = c;
   p.fan_begin.resize(nv + 1);
   p.fan_face.resize(nc);
   p.fan_edge.resize(nc);
