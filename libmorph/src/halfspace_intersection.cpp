@@ -459,6 +459,16 @@ class LazyExact {
   std::unique_ptr<std::once_flag[]> once_;
 };
 
+/// The double next to r (non-zero, finite, below the largest) away from zero when `away`,
+/// else towards it: its bit pattern plus or minus one (no libm call in the rounding loops).
+double step_away(double r, bool away) {
+  std::uint64_t bits;
+  std::memcpy(&bits, &r, sizeof bits);
+  bits = away ? bits + 1 : bits - 1;
+  std::memcpy(&r, &bits, sizeof bits);
+  return r;
+}
+
 /// X / W rounded to nearest (ties to even) from precise coordinates, when their enclosure
 /// lies strictly between two rounding midpoints (round-to-nearest); false otherwise (too
 /// close to a midpoint, or out of range): the exact rounding decides. X is within ex of
@@ -487,7 +497,7 @@ bool round_precise(const DD& X, double ex, const DD& W, double ew, double& out) 
   // (|W.lo| <= 2^-53 W.hi), and the half gaps are powers of two (products exact: no
   // underflow in this range).
   const double w_low = W.hi * (1 - 0x1p-50);
-  const double up = std::nextafter(r, HUGE_VAL) - r, down = r - std::nextafter(r, -HUGE_VAL);
+  const double up = step_away(r, r > 0) - r, down = r - step_away(r, r < 0);
   if (!(R + error < 0.5 * up * w_low && R - error > -0.5 * down * w_low)) return false;
   out = r;
   return true;
@@ -577,24 +587,28 @@ bool clockwise(const std::vector<int>& cyc, const std::vector<HVertex>& vertex,
 /// cannot decide.
 class VertexExactPoints final : public LazyExactPoints {
  public:
-  VertexExactPoints(std::vector<Plane> planes, std::vector<HVertex> vertex)
+  /// Vertex r is vertex[order[r]].
+  VertexExactPoints(std::vector<Plane> planes, std::vector<HVertex> vertex, std::vector<int> order)
       : planes_(std::move(planes)),
         vertex_(std::move(vertex)),
-        once_(std::make_unique<std::once_flag[]>(vertex_.size())) {}
-  void get(int v, const V3<ExactN>*& X, const ExactN*& W) const override {
-    std::call_once(once_[v], [&] { make_exact(planes_, vertex_[v]); });
-    X = &vertex_[v].X;
-    W = &vertex_[v].W;
+        order_(std::move(order)),
+        once_(std::make_unique<std::once_flag[]>(order_.size())) {}
+  void get(int r, const V3<ExactN>*& X, const ExactN*& W) const override {
+    HVertex& v = vertex_[order_[r]];
+    std::call_once(once_[r], [&] { make_exact(planes_, v); });
+    X = &v.X;
+    W = &v.W;
   }
 
  private:
   std::vector<Plane> planes_;
   mutable std::vector<HVertex> vertex_;  // each written once, under its once_flag
+  std::vector<int> order_;
   std::unique_ptr<std::once_flag[]> once_;
 };
 
 /// The exact points of the intersection's polytope, whose vertex r is vertex[order[r]]
-/// (moved out of `vertex`): computed on demand (VertexExactPoints), with the precise
+/// (`vertex` is moved away): computed on demand (VertexExactPoints), with the precise
 /// coordinates, or, when `eager`, all computed now and without precise coordinates (the
 /// route before, which tests compare with).
 ExactPoints polytope_points(const std::vector<Plane>& planes, std::vector<HVertex>& vertex,
@@ -616,9 +630,8 @@ ExactPoints polytope_points(const std::vector<Plane>& planes, std::vector<HVerte
   }
   exact.enclosure.resize(nv);
   exact.precise.resize(nv);
-  std::vector<HVertex> ordered(nv);
   for (int r = 0; r < nv; ++r) {
-    HVertex& v = vertex[order[r]];
+    const HVertex& v = vertex[order[r]];
     exact.enclosure[r] = v.xi;
     PrecisePoint& p = exact.precise[r];
     p.doubles = v.doubles;
@@ -629,9 +642,8 @@ ExactPoints polytope_points(const std::vector<Plane>& planes, std::vector<HVerte
       p.w_error = v.ew;
       p.valid = true;
     }
-    ordered[r] = std::move(v);
   }
-  exact.lazy = std::make_shared<VertexExactPoints>(planes, std::move(ordered));
+  exact.lazy = std::make_shared<VertexExactPoints>(planes, std::move(vertex), order);
   return exact;
 }
 
