@@ -253,9 +253,9 @@ TEST_CASE("halfspace_intersection: exact vertices plus doubles round as their ra
   const Polytope& p = *r.polytope;
   REQUIRE(!p.exact_points.empty());
   for (int v = 0; v < p.num_vertices(); ++v) {
-    const ExactN& W = p.exact_points.denominator[v];
-    const ExactN coordinates[3] = {p.exact_points.numerator[v].x, p.exact_points.numerator[v].y,
-                                   p.exact_points.numerator[v].z};
+    const ExactN& W = p.exact_points.W(v);
+    const ExactN coordinates[3] = {p.exact_points.X(v).x, p.exact_points.X(v).y,
+                                   p.exact_points.X(v).z};
     const double rounded[3] = {p.points[v].x, p.points[v].y, p.points[v].z};
     for (int i = 0; i < 3; ++i) {
       const double x = rounded[i];
@@ -692,4 +692,145 @@ TEST_CASE("halfspace_intersection: exact differences of doubles") {
   const V3<ExactN> v = exact_difference(V3<double>{1, 0x1p-1074, -1e300}, V3<double>{3, 1, 1e300});
   CHECK((v.x == ExactN(-2) && v.y == ExactN(0x1p-1074) - ExactN(1) &&
          v.z == ExactN(-1e300) - ExactN(1e300)));
+}
+
+namespace {
+
+/// x as a double-double times 2^scale, and a bound on its distance to x times 2^scale (the
+/// exact distance rounded up), optionally moved off it by `shift` of its lowest bits.
+DD scaled_dd(const ExactN& x, int scale, double shift, double& error) {
+  DD d = to_dd(x * ExactN(std::ldexp(1.0, scale)), error);
+  if (!std::isfinite(error)) return d;  // beyond the doubles
+  if (shift != 0) d = quick_two_sum(d.hi, d.lo + shift * std::ldexp(std::abs(d.hi), -104));
+  const ExactN off = ExactN(d.hi) + ExactN(d.lo) - x * ExactN(std::ldexp(1.0, scale));
+  // |off| rounded up (to_double is within half an ulp, or 2^-1075 below the normals).
+  error = CGAL::sign(off) == 0 ? 0 : std::nextafter(std::abs(off.to_double()), HUGE_VAL);
+  return d;
+}
+
+/// Same vertices bit for bit, in order, and the same facet cycles and labels.
+std::string mesh_difference(const morph::LabelledMesh& a, const morph::LabelledMesh& b) {
+  if (a.mesh.n_vertices() != b.mesh.n_vertices() || a.mesh.n_faces() != b.mesh.n_faces())
+    return "sizes differ";
+  for (std::size_t v = 0; v < a.mesh.n_vertices(); ++v)
+    for (int k = 0; k < 3; ++k)
+      if (!same_double(a.mesh.points()[v][k], b.mesh.points()[v][k]))
+        return "vertex " + std::to_string(v) + " differs";
+  for (const morph::Mesh::FaceHandle f : a.mesh.faces()) {
+    std::vector<int> fa, fb;
+    for (const morph::Mesh::VertexHandle v : a.mesh.fv_range(f)) fa.push_back(v.idx());
+    for (const morph::Mesh::VertexHandle v : b.mesh.fv_range(f)) fb.push_back(v.idx());
+    if (fa != fb) return "face " + std::to_string(f.idx()) + " differs";
+  }
+  if (a.origins.size() != b.origins.size()) return "labels differ";
+  for (std::size_t f = 0; f < a.origins.size(); ++f)
+    if (a.origins[f].kind != b.origins[f].kind || a.origins[f].a.index != b.origins[f].a.index ||
+        a.origins[f].b.index != b.origins[f].b.index)
+      return "label " + std::to_string(f) + " differs";
+  return "";
+}
+
+/// The opening's sum (A (-) B) (+) B with the eroded polytope's exact points on demand and
+/// its sums rounded by the precise stage, and by the route before (every exact point up
+/// front, every sum rounded exactly): the same polytope, the same mesh bit for bit.
+void check_opening_routes(const Polytope& A, const Polytope& B) {
+  const MaybePolytope lazy = erode_polytope(A, B);
+  const MaybePolytope eager = erode_polytope(A, B, {.eager_exact = true});
+  REQUIRE(lazy.reason == eager.reason);
+  if (!lazy.polytope) return;
+  CHECK(lazy.polytope->exact_points.lazy);
+  CHECK(!eager.polytope->exact_points.lazy);
+  CHECK(eager.polytope->exact_points.precise.empty());
+  const morph::LabelledMesh want = sum_mesh(*eager.polytope, B, fims_facets(*eager.polytope, B));
+  const morph::LabelledMesh got = sum_mesh(*lazy.polytope, B, fims_facets(*lazy.polytope, B));
+  CHECK(mesh_difference(got, want) == "");
+  // Every sum left to the exact rounding, on exact points computed on demand.
+  Polytope undecided = *lazy.polytope;
+  for (PrecisePoint& p : undecided.exact_points.precise) p.valid = p.doubles = false;
+  CHECK(mesh_difference(sum_mesh(undecided, B, fims_facets(undecided, B)), want) == "");
+  CHECK(difference(lazy, eager) == "");  // reads every exact point on demand
+  CHECK(rounded_from_exact(lazy));
+}
+
+}  // namespace
+
+// An opening rounds the sums e + b of the eroded polytope's vertices e = X / W (given in
+// double-double with error bounds, times an unknown factor) and double points b in
+// double-double (round_precise_sum), exactly only where that cannot decide. What it decides
+// must be mpfr's rounding of the rational sum: sums on exact ties, within 2^-k ulp of a
+// rounding midpoint, cancelling, at scales 2^+-200, far from the origin, with non-dyadic W,
+// factors 2^+-80 and double-doubles moved off the exact values within their bounds.
+TEST_CASE("halfspace_intersection: sums rounded by the precise stage are the exact roundings") {
+  const double bases[] = {1.0, 3.0, -5.0, 0.1, 12345.678, -0x1p40 - 1, 1e-3};
+  int decided = 0, decidable = 0, total = 0, near_decided = 0;
+  CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+  for (int s : {0, -200, 200}) {
+    for (int k : {1, 0, 10, 30, 45, 52, 60, 80}) {  // 1: an exact tie; 0: a double
+      for (int base = 0; base < 7; ++base) {
+        const double t = std::ldexp(bases[base], s);
+        const double ulp = std::nextafter(t, HUGE_VAL) - t;
+        ExactN y = ExactN(t);  // the sum e + b
+        if (k >= 1) y = y + ExactN(ulp / 2);
+        if (k > 1) y = y + ExactN(std::ldexp(ulp, -k) * (base % 2 ? 1 : -1));
+        const double want = round_to_nearest(Exact(y));
+        for (const double b : {0.0, std::ldexp(1.0, s), std::ldexp(-3.75, s), -t, t * 0.999,
+                               std::ldexp(1e15, s), std::ldexp(-7e13, s), 1e300, 0x1p-1070}) {
+          for (const ExactN& W : {ExactN(1), ExactN(3), ExactN(105), ExactN(0x1p-100) * ExactN(7),
+                                  ExactN(0x1p40) * ExactN(11)}) {
+            const ExactN X = (y - ExactN(b)) * W;  // e = X / W = y - b
+            for (int scale : {0, -80, 80}) {
+              for (double shift : {0.0, 3.0, -2.5}) {
+                double ex, ew, got;
+                const DD Xd = scaled_dd(X, scale, shift, ex), Wd = scaled_dd(W, scale, -shift, ew);
+                if (!std::isfinite(ex) || !std::isfinite(ew)) continue;
+                ++total;
+                if (!round_precise_sum(Xd, ex, Wd, ew, b, got)) continue;
+                ++decided;
+                if (k == 0 || k == 10 || k == 30) ++decidable;
+                if (k >= 60) ++near_decided;
+                CAPTURE(s);
+                CAPTURE(k);
+                CAPTURE(base);
+                CAPTURE(b);
+                CAPTURE(scale);
+                CHECK(k != 1);  // an exact tie is never decided (the bound is never zero)
+                CHECK(same_double(got, want));
+              }
+            }
+          }
+        }
+      }
+    }
+  }
+  MESSAGE(decided << " of " << total << " sums decided by the precise stage, " << near_decided
+                  << " within 2^-60 ulp of a midpoint");
+  CHECK(decidable > total / 8);  // the stage does its work where it can
+  CHECK(near_decided == 0);      // its bound is far wider than 2^-60 ulp
+}
+
+// Whole openings by both routes: random polytopes and elements of several sizes, operands
+// scaled by 2^+-200, far from the origin, and an element 2^-40 times A's size (its sums lie
+// within rounding of A's vertices).
+TEST_CASE("halfspace_intersection: openings with exact points on demand are the exact route's") {
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    for (const double size : {0.02, 0.1, 0.4}) {
+      CAPTURE(seed);
+      CAPTURE(size);
+      const Polytope A = make_operand(morph::test::random_sphere_polytope(60, seed), "A");
+      const morph::Mesh B = seed % 3 == 0 ? morph::test::random_integer_polytope(8, seed, 2)
+                                          : morph::test::random_sphere_polytope(
+                                                10 + static_cast<int>(seed), seed + 50);
+      check_opening_routes(A, make_operand(morph::test::scaled(B, size), "B"));
+    }
+  }
+  const morph::Mesh& a = sample("icosphere_320.off");
+  const morph::Mesh b =
+      morph::test::transformed(sample("icosphere_80.off"), morph::test::random_rotation(11));
+  const std::pair<morph::Mesh, morph::Mesh> cases[] = {
+      {a, morph::test::scaled(b, 0x1p-40)},
+      {morph::test::scaled(a, 0x1p200), morph::test::scaled(b, 0x1p195)},
+      {morph::test::scaled(a, 0x1p-200), morph::test::scaled(b, 0x1p-205)},
+      {morph::test::translated(a, {1e6, -3e5, 7e5}), morph::test::scaled(b, 1.0 / 32)},
+  };
+  for (const auto& [A, B] : cases) check_opening_routes(make_operand(A, "A"), make_operand(B, "B"));
 }

@@ -459,6 +459,16 @@ class LazyExact {
   std::unique_ptr<std::once_flag[]> once_;
 };
 
+/// The double next to r (non-zero, finite, below the largest) away from zero when `away`,
+/// else towards it: its bit pattern plus or minus one (no libm call in the rounding loops).
+double step_away(double r, bool away) {
+  std::uint64_t bits;
+  std::memcpy(&bits, &r, sizeof bits);
+  bits = away ? bits + 1 : bits - 1;
+  std::memcpy(&r, &bits, sizeof bits);
+  return r;
+}
+
 /// X / W rounded to nearest (ties to even) from precise coordinates, when their enclosure
 /// lies strictly between two rounding midpoints (round-to-nearest); false otherwise (too
 /// close to a midpoint, or out of range): the exact rounding decides. X is within ex of
@@ -487,7 +497,7 @@ bool round_precise(const DD& X, double ex, const DD& W, double ew, double& out) 
   // (|W.lo| <= 2^-53 W.hi), and the half gaps are powers of two (products exact: no
   // underflow in this range).
   const double w_low = W.hi * (1 - 0x1p-50);
-  const double up = std::nextafter(r, HUGE_VAL) - r, down = r - std::nextafter(r, -HUGE_VAL);
+  const double up = step_away(r, r > 0) - r, down = r - step_away(r, r < 0);
   if (!(R + error < 0.5 * up * w_low && R - error > -0.5 * down * w_low)) return false;
   out = r;
   return true;
@@ -571,13 +581,80 @@ bool clockwise(const std::vector<int>& cyc, const std::vector<HVertex>& vertex,
   return CGAL::sign(dot(nw, to_rational(normal))) < 0;
 }
 
+/// An intersection's exact vertices, each computed on first use from its three planes (or
+/// taken from its known point) by whichever thread needs it first, as LazyExact does: an
+/// opening's sums are rounded from the precise points, and read these only where that
+/// cannot decide.
+class VertexExactPoints final : public LazyExactPoints {
+ public:
+  /// Vertex r is vertex[order[r]].
+  VertexExactPoints(std::vector<Plane> planes, std::vector<HVertex> vertex, std::vector<int> order)
+      : planes_(std::move(planes)),
+        vertex_(std::move(vertex)),
+        order_(std::move(order)),
+        once_(std::make_unique<std::once_flag[]>(order_.size())) {}
+  void get(int r, const V3<ExactN>*& X, const ExactN*& W) const override {
+    HVertex& v = vertex_[order_[r]];
+    std::call_once(once_[r], [&] { make_exact(planes_, v); });
+    X = &v.X;
+    W = &v.W;
+  }
+
+ private:
+  std::vector<Plane> planes_;
+  mutable std::vector<HVertex> vertex_;  // each written once, under its once_flag
+  std::vector<int> order_;
+  std::unique_ptr<std::once_flag[]> once_;
+};
+
+/// The exact points of the intersection's polytope, whose vertex r is vertex[order[r]]
+/// (`vertex` is moved away): computed on demand (VertexExactPoints), with the precise
+/// coordinates, or, when `eager`, all computed now and without precise coordinates (the
+/// route before, which tests compare with).
+ExactPoints polytope_points(const std::vector<Plane>& planes, std::vector<HVertex>& vertex,
+                            const std::vector<int>& order, bool eager) {
+  const int nv = static_cast<int>(order.size());
+  ExactPoints exact;
+  if (eager) {
+    exact.resize(nv);
+    parallel_chunks(nv, 128, [&](int begin, int end) {
+      for (int r = begin; r < end; ++r) {
+        HVertex& v = vertex[order[r]];
+        make_exact(planes, v);
+        exact.numerator[r] = v.X;
+        exact.denominator[r] = v.W;
+        exact.enclosure[r] = v.xi;
+      }
+    });
+    return exact;
+  }
+  exact.enclosure.resize(nv);
+  exact.precise.resize(nv);
+  for (int r = 0; r < nv; ++r) {
+    const HVertex& v = vertex[order[r]];
+    exact.enclosure[r] = v.xi;
+    PrecisePoint& p = exact.precise[r];
+    p.doubles = v.doubles;
+    if (v.precise) {
+      p.X = v.px;
+      p.W = v.pw;
+      p.error = v.ex;
+      p.w_error = v.ew;
+      p.valid = true;
+    }
+  }
+  exact.lazy = std::make_shared<VertexExactPoints>(planes, std::move(vertex), order);
+  return exact;
+}
+
 /// Builds the intersection from a candidate dual hull, checking exactly that it is the
 /// dual hull of all the planes; nullopt when it is not. The result has `rounded`, and
-/// `polytope` when `with_polytope`.
+/// `polytope` when `with_polytope` (its exact points computed up front when `eager_exact`,
+/// else on demand: polytope_points).
 std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
                                             const std::vector<Plane>& planes,
                                             const KnownPoints& known, const DualSurface& s,
-                                            bool with_polytope) {
+                                            bool with_polytope, bool eager_exact) {
   const int nt = static_cast<int>(s.corner.size());
   const int n = static_cast<int>(planes.size());
   if (nt == 0) return std::nullopt;
@@ -703,8 +780,8 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   }
   if (faces.size() < 4) return std::nullopt;
   // Precise vertices, for the checks below (a second filter stage) and the rounding; exact
-  // ones only where those cannot decide (LazyExact), but all of them for a polytope that is
-  // computed with further.
+  // ones only where those cannot decide (LazyExact; for a polytope computed with further,
+  // see polytope_points).
   // The planes of vertices that are not known points are made precise up front; the
   // others when the walk below first needs them.
   std::vector<PrecisePlane> precise(n);
@@ -720,10 +797,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   }
   parallel_chunks(nv, 128, [&](int begin, int end) {
     CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
-    for (int v = begin; v < end; ++v) {
-      make_precise(precise, vertex[v]);
-      if (with_polytope) make_exact(planes, vertex[v]);
-    }
+    for (int v = begin; v < end; ++v) make_precise(precise, vertex[v]);
   });
   LazyExact exact_vertex(planes, vertex);
   const auto side_of = [&](const Plane& p, LazyPrecisePlane& q, int v) {
@@ -819,13 +893,10 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       for (auto& c : faces) std::reverse(c.begin(), c.end());
   }
   // Rounded vertices, exactly rounded from the homogeneous coordinates: from the precise
-  // ones unless they lie too close to a rounding midpoint, from the exact ones then;
-  // rationals only for a polytope that is computed with further.
+  // ones unless they lie too close to a rounding midpoint, from the exact ones then.
   MaybePolytope out;
   RoundedPolytope& rp = out.rounded;
   rp.points.resize(nv);
-  ExactPoints exact;
-  if (with_polytope) exact.resize(nv);
   parallel_chunks(nv, 128, [&](int begin, int end) {
     CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);  // for round_precise
     const auto coordinate = [](const auto& p, int i) -> const auto& {
@@ -846,10 +917,6 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
         rounded[i] = round_quotient(coordinate(e.X, i), e.W, coordinate(v.xi, i));
       }
       rp.points[r] = {rounded[0], rounded[1], rounded[2]};
-      if (!with_polytope) continue;
-      exact.numerator[r] = v.X;
-      exact.denominator[r] = v.W;
-      exact.enclosure[r] = v.xi;
     }
   });
   rp.face_begin.assign(1, 0);
@@ -862,7 +929,8 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   if (with_polytope) {
     std::vector<V3<ExactN>> normals(faces.size());
     for (std::size_t f = 0; f < faces.size(); ++f) normals[f] = hs[face_halfspace[f]].normal;
-    Polytope p = make_polytope(rp.points, std::move(exact), faces, std::move(normals), "A (-) B");
+    Polytope p = make_polytope(rp.points, polytope_points(planes, vertex, order, eager_exact),
+                               faces, std::move(normals), "A (-) B");
     for (auto& src : p.face_source) src = hs[face_halfspace[src]].source;
     out.polytope = std::move(p);
   }
@@ -1358,7 +1426,7 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
   // the duality argument hold, so the rounded o only has to centre the virtual planes.
   if (options.incremental && options.guess && !expected.empty()) {
     if (auto built = build_verified(hs, planes, known, expected_surface(planes, known, expected),
-                                    options.polytope)) {
+                                    options.polytope, options.eager_exact)) {
       built->route = HullRoute::expected;
       return std::move(*built);
     }
@@ -1370,7 +1438,8 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
       const auto outcome = IncrementalHull(planes, known, o_double, reach).run(s);
       if (outcome == IncrementalHull::Outcome::too_small) continue;
       if (outcome == IncrementalHull::Outcome::hull) {
-        if (auto built = build_verified(hs, planes, known, s, options.polytope)) {
+        if (auto built =
+                build_verified(hs, planes, known, s, options.polytope, options.eager_exact)) {
           built->route = HullRoute::incremental;
           return std::move(*built);
         }
@@ -1378,7 +1447,8 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
       break;
     }
   }
-  auto built = build_verified(hs, planes, known, exact_dual_hull(planes, o), options.polytope);
+  auto built = build_verified(hs, planes, known, exact_dual_hull(planes, o), options.polytope,
+                              options.eager_exact);
   if (!built) throw error("internal error: the exact dual hull of an erosion failed its own check");
   built->route = HullRoute::exact;
   return std::move(*built);
@@ -1392,7 +1462,7 @@ struct Homogeneous {
 };
 Homogeneous homogeneous_dot(const Polytope& P, const V3<ExactN>& n, int v) {
   if (P.exact_points.empty()) return {dot(n, to_exact_n(P.points[v])), ExactN(1)};
-  return {dot(n, P.exact_points.numerator[v]), P.exact_points.denominator[v]};
+  return {dot(n, P.exact_points.X(v)), P.exact_points.W(v)};
 }
 /// The Newell normal of triangle f of a polytope with double points.
 V3<ExactN> triangle_normal(const Polytope& A, int f) {
@@ -1515,10 +1585,9 @@ KnownPoints erosion_points(const Polytope& A, const Polytope& B,
         known.Xi[k] = to_interval(A.points[v]) - to_interval(B.points[b]);
         known.Wi[k] = Interval(1);
       } else {
-        const ExactN& w = A.exact_points.denominator[v];
+        const ExactN& w = A.exact_points.W(v);
         const V3<ExactN> bn = to_exact_n(B.points[b]);
-        known.X[k] =
-            A.exact_points.numerator[v] - (w == 1 ? bn : V3<ExactN>{bn.x * w, bn.y * w, bn.z * w});
+        known.X[k] = A.exact_points.X(v) - (w == 1 ? bn : V3<ExactN>{bn.x * w, bn.y * w, bn.z * w});
         known.W[k] = w;
         known.Xi[k] = to_interval_n(known.X[k]);
         known.Wi[k] = to_interval_n(known.W[k]);
@@ -1631,6 +1700,21 @@ MaybePolytope erode_sum(const Polytope& S, const Polytope& A, const Polytope& B,
     for (int f : A.fan_face) expected.facets.push_back(facet_of[f]);
   }
   return erode(S, B, options, S.sum_pairs.empty() ? SumOfB::no : SumOfB::yes, expected);
+}
+
+bool round_precise_sum(const DD& X, double error, const DD& W, double w_error, double b,
+                       double& out) {
+  // X / W + b = (X + b W) / W. In this range the double-double product and sum neither
+  // overflow nor lose their splits (below 2^995); underflow is covered by the absolute term.
+  if (!(W.hi >= 0x1p-300 && W.hi <= 0x1p300) || !(std::abs(b) <= 0x1p600) ||
+      !(std::abs(X.hi) <= 0x1p900))
+    return false;
+  const DD sum = X + DD{b, 0} * W;
+  // The numerator's error: X's, W's times |b|, and the product and the sum, each within
+  // 4 u^2 of the magnitude of its operands (|b| |W|, then |X| + |b W|), taken as 16 u^2.
+  const double magnitude = std::abs(X.hi) + std::abs(b) * W.hi;
+  const double bound = (error + std::abs(b) * w_error + 16 * kU2 * magnitude) * 1.01 + 0x1p-1000;
+  return round_precise(sum, bound, W, w_error, out);
 }
 
 }  // namespace morph::detail

@@ -61,6 +61,9 @@ struct IntersectOptions {
   bool incremental = true;  // false: go straight to the exact hull (tests compare the routes)
   bool polytope = true;     // false: only `rounded` (a final result: no rationals, no Polytope)
   bool guess = true;        // false: ignore ExpectedVertices (tests compare the routes)
+  // true: the polytope's exact points are all computed up front and it has no precise points
+  // (its sums are then rounded exactly; tests compare the routes). false: on demand.
+  bool eager_exact = false;
 };
 
 /// Points known to lie exactly on some of the half-spaces' planes: an erosion knows them
@@ -137,6 +140,14 @@ struct PreciseProbe {
 PreciseProbe probe_precise(const std::vector<HalfSpace>& hs);
 /// The rounding of a point known exactly, X / W (W > 0), as an erosion's known points.
 PreciseProbe probe_precise_point(const V3<ExactN>& X, const ExactN& W);
+
+/// One coordinate of X / W + b rounded to nearest (ties to even), for X / W a vertex given
+/// by its precise coordinates (a PrecisePoint's X.x, error.x, W, w_error, or y, or z) and b a
+/// double, when the precise stage decides; false when the sum lies too close to a rounding
+/// midpoint (or out of range): round_quotient on exact coordinates decides then. Needs
+/// round-to-nearest.
+bool round_precise_sum(const DD& X, double error, const DD& W, double w_error, double b,
+                       double& out);
 
 /// A (-) B = intersection over facets f of A of { x : <N_f, x> <= h_A(N_f) - h_B(N_f) }.
 /// The facets of A through a vertex v moved by a vertex b of B (one that attains h_B(N_f))

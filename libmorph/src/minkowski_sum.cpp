@@ -10,6 +10,7 @@
 
 #include "fims.h"
 #include "gauss_map.h"
+#include "halfspace_intersection.h"
 #include "parallel.h"
 
 namespace morph::detail {
@@ -334,12 +335,40 @@ struct Homogeneous {
 };
 Homogeneous homogeneous(const Polytope& p, int v) {
   if (p.exact_points.empty()) return {to_exact_n(p.points[v]), ExactN(1), p.points[v]};
-  return {p.exact_points.numerator[v], p.exact_points.denominator[v], p.points[v]};
+  return {p.exact_points.X(v), p.exact_points.W(v), p.points[v]};
+}
+
+/// E(i) + b rounded to the nearest doubles for E's exact point i and a double point b, from
+/// E's precise point (round_precise_sum) where that decides, else exactly (round_quotient
+/// on E's exact coordinates, computed on demand): an opening's sums, nearly all decided
+/// without reading an exact point.
+V3<double> round_sum_with_precise(const Polytope& E, int i, const V3<double>& b) {
+  CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+  const PrecisePoint& p = E.exact_points.precise[i];
+  const V3<double>& e = E.points[i];
+  if (p.doubles) return {e.x + b.x, e.y + b.y, e.z + b.z};  // E(i) is e: correctly rounded
+  double out[3];
+  const double bc[3] = {b.x, b.y, b.z}, ec[3] = {e.x, e.y, e.z};
+  const DD X[3] = {p.X.x, p.X.y, p.X.z};
+  const double error[3] = {p.error.x, p.error.y, p.error.z};
+  for (int k = 0; k < 3; ++k) {
+    if (p.valid && round_precise_sum(X[k], error[k], p.W, p.w_error, bc[k], out[k])) continue;
+    const V3<ExactN>& x = E.exact_points.X(i);
+    const ExactN& w = E.exact_points.W(i);
+    const ExactN& xk = k == 0 ? x.x : k == 1 ? x.y : x.z;
+    out[k] = round_quotient(xk + ExactN(bc[k]) * w, w, Interval(ec[k] + bc[k]));
+  }
+  return {out[0], out[1], out[2]};
 }
 
 /// A(i) + B(j) rounded to the nearest doubles, when a point is exact: homogeneous sums
-/// rounded by round_quotient, no rationals (the same values as rounding the rational sum).
+/// rounded by round_quotient, no rationals (the same values as rounding the rational sum);
+/// by the precise stage first when one point is double and the other has precise coordinates.
 V3<double> round_exact_sum(const Polytope& A, int i, const Polytope& B, int j) {
+  if (B.exact_points.empty() && !A.exact_points.precise.empty())
+    return round_sum_with_precise(A, i, B.points[j]);
+  if (A.exact_points.empty() && !B.exact_points.precise.empty())
+    return round_sum_with_precise(B, j, A.points[i]);
   const Homogeneous a = homogeneous(A, i), b = homogeneous(B, j);
   // a.X / a.W + b.X / b.W; a double point has W = 1, and needs no multiplication by it.
   const auto sum = [&](const ExactN& x, const ExactN& y) -> ExactN {

@@ -497,8 +497,8 @@ int edge_convexity(const Polytope& p, const Polytope::Edge& e) {
   // X_to / W_to - X_from / W_from has the direction of X_to W_from - X_from W_to (W > 0):
   // dyadic, no rationals.
   const ExactPoints& x = p.exact_points;
-  const ExactN &w_to = x.denominator[e.to], &w_from = x.denominator[e.from];
-  const V3<ExactN>&a = x.numerator[e.to], &b = x.numerator[e.from];
+  const ExactN &w_to = x.W(e.to), &w_from = x.W(e.from);
+  const V3<ExactN>&a = x.X(e.to), &b = x.X(e.from);
   const V3<ExactN> direction{a.x * w_from - b.x * w_to, a.y * w_from - b.y * w_to,
                              a.z * w_from - b.z * w_to};
   return CGAL::sign(det(p.exact_normal(e.left), p.exact_normal(e.right), direction));
@@ -795,10 +795,14 @@ Polytope make_polytope(std::vector<V3<double>> points, ExactPoints exact_points,
     for (int v = 0; v < p.num_vertices(); ++v) {
       if (new_index[v] < 0) continue;
       pts[new_index[v]] = p.points[v];
-      if (exact) {
-        epts.numerator[new_index[v]] = p.exact_points.numerator[v];
-        epts.denominator[new_index[v]] = p.exact_points.denominator[v];
+      if (exact) {  // (lazy exact points are computed here: they are renumbered)
+        epts.numerator[new_index[v]] = p.exact_points.X(v);
+        epts.denominator[new_index[v]] = p.exact_points.W(v);
         epts.enclosure[new_index[v]] = p.exact_points.enclosure[v];
+        if (!p.exact_points.precise.empty()) {
+          epts.precise.resize(used);
+          epts.precise[new_index[v]] = p.exact_points.precise[v];
+        }
       }
       vsrc[new_index[v]] = v;
     }

@@ -46,23 +46,67 @@ struct PreciseNormal {
   bool exactly_zero(int i) const { return error[i] == 0 && hi[i] == 0; }
 };
 
+/// A vertex X / W (W > 0) in double-double arithmetic, times some unknown positive factor:
+/// X.x is within error.x of the exact X.x times that factor (and so on), W within w_error.
+/// Not `valid` when the precise stage could not represent the vertex. `doubles`: X / W is
+/// exactly the vertex's double point (then nothing else is set).
+struct PrecisePoint {
+  V3<DD> X{};
+  DD W{};
+  V3<double> error{};
+  double w_error = 0;
+  bool valid = false;
+  bool doubles = false;
+};
+
+/// Exact vertex coordinates computed on demand: an erosion chained into a dilation reads
+/// them only where the precise stage cannot round a sum (see ExactPoints::lazy).
+class LazyExactPoints {
+ public:
+  virtual ~LazyExactPoints() = default;
+  /// Vertex v's exact homogeneous coordinates (thread-safe; each computed at most once,
+  /// the same values whichever thread asks first).
+  virtual void get(int v, const V3<ExactN>*& X, const ExactN*& W) const = 0;
+};
+
 /// Exact vertex positions that are not doubles (an erosion's vertices), in homogeneous
 /// dyadic coordinates: vertex v is numerator[v] / denominator[v] (denominator > 0), within
 /// the interval box enclosure[v]. Rationals would cost three gcds per vertex to build and
-/// more to add; these are exactly what the intersection computed.
+/// more to add; these are exactly what the intersection computed. When `lazy` is set,
+/// numerator and denominator are empty and `lazy` computes them on demand: read them
+/// through X(v) and W(v), which work in both cases.
 struct ExactPoints {
   std::vector<V3<ExactN>> numerator;
   std::vector<ExactN> denominator;
   std::vector<V3<Interval>> enclosure;
-  bool empty() const { return denominator.empty(); }
+  // Optional (empty: none): the vertices in double-double, for roundings that need not
+  // read the exact coordinates (sums with double points, see sum_mesh).
+  std::vector<PrecisePoint> precise;
+  std::shared_ptr<const LazyExactPoints> lazy;
+  bool empty() const { return denominator.empty() && !lazy; }
   void resize(std::size_t n) {
     numerator.resize(n);
     denominator.resize(n);
     enclosure.resize(n);
   }
+  const V3<ExactN>& X(int v) const {
+    if (!lazy) return numerator[v];
+    const V3<ExactN>* x;
+    const ExactN* w;
+    lazy->get(v, x, w);
+    return *x;
+  }
+  const ExactN& W(int v) const {
+    if (!lazy) return denominator[v];
+    const V3<ExactN>* x;
+    const ExactN* w;
+    lazy->get(v, x, w);
+    return *w;
+  }
   V3<Exact> rational(int v) const {
-    const Exact w(denominator[v]);
-    return {Exact(numerator[v].x) / w, Exact(numerator[v].y) / w, Exact(numerator[v].z) / w};
+    const V3<ExactN>& x = X(v);
+    const Exact w(W(v));
+    return {Exact(x.x) / w, Exact(x.y) / w, Exact(x.z) / w};
   }
 };
 
