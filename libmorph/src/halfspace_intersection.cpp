@@ -1754,10 +1754,11 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
   std::vector<int> contributing(nf);
   std::vector<std::vector<int>> others(nf);
   std::atomic<bool> general{!doubles};
-  // Each facet of S is translated (one vertex of B: A's facet, in A's order), a corner (one
-  // vertex of A: a facet of B) or a parallelogram (an edge of each), with A's and B's facets
-  // exactly planar; anything else (parallel facets or edges summed into one polygon, facets
-  // only nearly planar) goes the general way, through S.
+  // Each facet of S is usually translated (one vertex of B: A's facet, in A's order), a
+  // corner (one vertex of A: a facet of B) or a parallelogram (an edge of each). A's and B's
+  // facets must be exactly planar (each is checked where it lies in S: A's facet g in S's
+  // facet g, B's in the one facet of S along its normal); otherwise the closing goes through
+  // S.
   parallel_chunks(doubles ? nf : 0, 64, [&](int begin, int end) {
     for (int g = begin; g < end && !general.load(std::memory_order_relaxed); ++g) {
       const int c0 = sum.face_begin[g], d = sum.face_begin[g + 1] - c0;
@@ -1771,13 +1772,16 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
       HalfSpace& h = hs[g];
       int b = -1;
       std::optional<V3<ExactN>> n;
-      if (one_j) {
-        if (g < na && same_cycle(A, g, d, i_at)) n = planar_normal(A, g);
+      bool simple = false;  // translated, corner or parallelogram: n from A's or B's facet
+      if (one_j && g < na && same_cycle(A, g, d, i_at)) {
+        simple = true;
+        n = planar_normal(A, g);
         b = j_at(0);
       } else if (one_i) {
         const int e = d >= 3 ? edge_between(B, j_at(0), j_at(1)) : -1;
         const int f = e < 0 ? -1 : B.edges[e].from == j_at(0) ? B.edges[e].left : B.edges[e].right;
         if (same_cycle(B, f, d, j_at)) {
+          simple = true;
           n = planar_normal(B, f);
           b = B.corner(f, 0);
           for (int k = 1; k < d; ++k) others[g].push_back(B.corner(f, k));
@@ -1798,10 +1802,57 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
         }
         const int e = parallelogram ? edge_between(B, j_at(0), j_at(2)) : -1;
         if (e >= 0) {
+          simple = true;
           const V3<ExactN> m = cross(side[0], side[1]);
           n = V3<ExactN>{m.x + m.x, m.y + m.y, m.z + m.z};
           b = B.edges[e].from;
           others[g].push_back(B.edges[e].to);
+        }
+      }
+      if (!simple) {
+        // Parallel features summed into one polygon (f + an edge or a facet of B, a facet
+        // of B + an edge of A, parallel edges): B's face along n is spanned by the distinct
+        // j (a vertex, an edge, or a whole facet of B), moved as erode moves it, and n is
+        // the Newell normal of the exact sums, as sum_polytope makes it. A's facet g, and
+        // B's facet, must be planar as above.
+        std::vector<int> is, js;
+        for (int k = 0; k < d; ++k) {
+          if (std::find(is.begin(), is.end(), i_at(k)) == is.end()) is.push_back(i_at(k));
+          if (std::find(js.begin(), js.end(), j_at(k)) == js.end()) js.push_back(j_at(k));
+        }
+        // A's face along n: facet g of A (FIMS's translated facets come first, in A's
+        // order), or a vertex or an edge.
+        bool known_face = g < na ? planar_normal(A, g).has_value() : is.size() <= 2;
+        if (js.size() == 1) {
+          b = js[0];
+        } else if (js.size() == 2) {
+          const int e = edge_between(B, js[0], js[1]);
+          known_face = known_face && e >= 0;
+          if (e >= 0) {
+            b = B.edges[e].from;
+            others[g].push_back(B.edges[e].to);
+          }
+        } else {
+          int f = -1;
+          for (int s = B.fan_begin[js[0]]; s < B.fan_begin[js[0] + 1] && f < 0; ++s) {
+            const int c = B.fan_face[s];
+            if (B.degree(c) != static_cast<int>(js.size())) continue;
+            bool all = true;
+            for (int k = 0; k < B.degree(c) && all; ++k)
+              all = std::find(js.begin(), js.end(), B.corner(c, k)) != js.end();
+            if (all) f = c;
+          }
+          known_face = known_face && f >= 0 && planar_normal(B, f).has_value();
+          if (known_face) {
+            b = B.corner(f, 0);
+            for (int k = 1; k < B.degree(f); ++k) others[g].push_back(B.corner(f, k));
+          }
+        }
+        if (known_face) {
+          std::vector<V3<ExactN>> cycle(d);
+          for (int k = 0; k < d; ++k)
+            cycle[k] = to_exact_n(A.points[i_at(k)]) + to_exact_n(B.points[j_at(k)]);
+          n = newell_normal<ExactN>(d, [&](int k) -> const V3<ExactN>& { return cycle[k]; });
         }
       }
       if (!n) {

@@ -160,10 +160,11 @@ MaybePolytope erode_sum(const Polytope& S, const Polytope& A, const Polytope& B,
 /// The same closing from the facets of S = A (+) B (fims_facets(A, B)), without S: a facet
 /// of S is A's face plus B's face along its normal n, so its plane moved back by h_B(n) is
 /// <n, x> = <n, a_i> for any of its corners (a_i, b_j). The normals come from the operands
-/// (A's facet, B's facet, or the cross product of an edge of each), exactly the Newell
-/// normals S would have, and the half-spaces, known points and guess are erode_sum's on S.
-/// Parallel facets or edges summed into one polygon, and facets planar only within the
-/// tolerance, go through sum_polytope and erode_sum as before.
+/// (A's facet, B's facet, the cross product of an edge of each, or the Newell normal of the
+/// exact sums where parallel features were summed into one polygon), exactly the normals S
+/// would have, and the half-spaces, known points and guess are erode_sum's on S. When a facet
+/// of A or B is planar only within the tolerance, S may differ (merged facets): the closing
+/// goes through sum_polytope and erode_sum as before.
 MaybePolytope erode_sum(const SumFacets& sum, const Polytope& A, const Polytope& B,
                         const IntersectOptions& options = {});
 
