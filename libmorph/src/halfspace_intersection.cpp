@@ -1701,11 +1701,14 @@ void number_pairs(const SumFacets& facets, int num_a, int num_b, std::vector<std
   }
 }
 
-/// Facet f of P (double points) as it is in a sum: its exact Newell normal (for a triangle
-/// (q - p) x (r - p), the same value), or nothing when its corners are not exactly on one
-/// plane.
-std::optional<V3<ExactN>> planar_normal(const Polytope& P, int f) {
-  if (P.degree(f) == 3) return triangle_normal(P, f);
+/// Whether facet f of P (double points) is exactly planar; its exact Newell normal into
+/// `normal` (when not null) if it is. A triangle is, and its normal is (q - p) x (r - p), the
+/// same value.
+bool planar_normal(const Polytope& P, int f, V3<ExactN>* normal) {
+  if (P.degree(f) == 3) {
+    if (normal) *normal = triangle_normal(P, f);
+    return true;
+  }
   std::vector<V3<ExactN>> cycle;
   cycle.reserve(P.degree(f));
   for (int k = 0; k < P.degree(f); ++k) cycle.push_back(to_exact_n(P.points[P.corner(f, k)]));
@@ -1713,8 +1716,9 @@ std::optional<V3<ExactN>> planar_normal(const Polytope& P, int f) {
       newell_normal<ExactN>(P.degree(f), [&](int i) -> const V3<ExactN>& { return cycle[i]; });
   const V3<double>& p = P.points[P.corner(f, 0)];
   for (int k = 1; k < P.degree(f); ++k)
-    if (CGAL::sign(dot(n, exact_difference(P.points[P.corner(f, k)], p))) != 0) return std::nullopt;
-  return n;
+    if (CGAL::sign(dot(n, exact_difference(P.points[P.corner(f, k)], p))) != 0) return false;
+  if (normal) *normal = n;
+  return true;
 }
 
 /// Where facet f of P is, as a cycle of P's vertices starting anywhere: the k-th corner of
@@ -1771,18 +1775,18 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
       }
       HalfSpace& h = hs[g];
       int b = -1;
-      std::optional<V3<ExactN>> n;
+      bool found = false;   // h.normal is S's normal n (the faces along n exactly planar)
       bool simple = false;  // translated, corner or parallelogram: n from A's or B's facet
       if (one_j && g < na && same_cycle(A, g, d, i_at)) {
         simple = true;
-        n = planar_normal(A, g);
+        found = planar_normal(A, g, &h.normal);
         b = j_at(0);
       } else if (one_i) {
         const int e = d >= 3 ? edge_between(B, j_at(0), j_at(1)) : -1;
         const int f = e < 0 ? -1 : B.edges[e].from == j_at(0) ? B.edges[e].left : B.edges[e].right;
         if (same_cycle(B, f, d, j_at)) {
           simple = true;
-          n = planar_normal(B, f);
+          found = planar_normal(B, f, &h.normal);
           b = B.corner(f, 0);
           for (int k = 1; k < d; ++k) others[g].push_back(B.corner(f, k));
         }
@@ -1804,7 +1808,8 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
         if (e >= 0) {
           simple = true;
           const V3<ExactN> m = cross(side[0], side[1]);
-          n = V3<ExactN>{m.x + m.x, m.y + m.y, m.z + m.z};
+          h.normal = {m.x + m.x, m.y + m.y, m.z + m.z};
+          found = true;
           b = B.edges[e].from;
           others[g].push_back(B.edges[e].to);
         }
@@ -1822,7 +1827,7 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
         }
         // A's face along n: facet g of A (FIMS's translated facets come first, in A's
         // order), or a vertex or an edge.
-        bool known_face = g < na ? planar_normal(A, g).has_value() : is.size() <= 2;
+        bool known_face = g < na ? planar_normal(A, g, nullptr) : is.size() <= 2;
         if (js.size() == 1) {
           b = js[0];
         } else if (js.size() == 2) {
@@ -1842,7 +1847,7 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
               all = std::find(js.begin(), js.end(), B.corner(c, k)) != js.end();
             if (all) f = c;
           }
-          known_face = known_face && f >= 0 && planar_normal(B, f).has_value();
+          known_face = known_face && f >= 0 && planar_normal(B, f, nullptr);
           if (known_face) {
             b = B.corner(f, 0);
             for (int k = 1; k < B.degree(f); ++k) others[g].push_back(B.corner(f, k));
@@ -1852,16 +1857,16 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
           std::vector<V3<ExactN>> cycle(d);
           for (int k = 0; k < d; ++k)
             cycle[k] = to_exact_n(A.points[i_at(k)]) + to_exact_n(B.points[j_at(k)]);
-          n = newell_normal<ExactN>(d, [&](int k) -> const V3<ExactN>& { return cycle[k]; });
+          h.normal = newell_normal<ExactN>(d, [&](int k) -> const V3<ExactN>& { return cycle[k]; });
+          found = true;
         }
       }
-      if (!n) {
+      if (!found) {
         general.store(true, std::memory_order_relaxed);
         break;
       }
       // Every corner (i, j) of the facet lies on its plane, and j on B's face for its normal:
       // h_S - h_B = <n, a_i + b_j> - <n, b_j> = <n, a_i>.
-      h.normal = std::move(*n);
       h.offset = dot(h.normal, to_exact_n(A.points[i_at(0)]));
       h.source = g;
       h.element = B.vertex_source[b];
