@@ -1721,9 +1721,8 @@ bool planar_normal(const Polytope& P, int f, V3<ExactN>* normal) {
   return true;
 }
 
-/// Where facet f of P is, as a cycle of P's vertices starting anywhere: the k-th corner of
-/// the cycle is corner (start + k) mod d of f, or -1 when the cycle (of `d` vertices, read
-/// by vertex_at(k)) is not f's.
+/// Whether the cycle of `d` vertices of P read by vertex_at(k) is facet f's (f >= 0), in the
+/// same order from any start.
 template <class VertexAt>
 bool same_cycle(const Polytope& P, int f, int d, const VertexAt& vertex_at) {
   if (f < 0 || P.degree(f) != d) return false;
