@@ -338,6 +338,108 @@ TEST_CASE("halfspace_intersection: a closing's expected result") {
   }
 }
 
+/// "" when two erosion inputs are the same exactly: half-spaces (normals, offsets, labels, in
+/// order), hint, known points and guess.
+std::string input_difference(const ErosionInput& got, const ErosionInput& want) {
+  const auto same3 = [](const V3<ExactN>& a, const V3<ExactN>& b) {
+    return a.x == b.x && a.y == b.y && a.z == b.z;
+  };
+  const auto same_interval = [](const Interval& a, const Interval& b) {
+    return a.inf() == b.inf() && a.sup() == b.sup();
+  };
+  if (got.halfspaces.size() != want.halfspaces.size()) return "half-space counts differ";
+  for (std::size_t k = 0; k < got.halfspaces.size(); ++k) {
+    const HalfSpace &g = got.halfspaces[k], &w = want.halfspaces[k];
+    if (!same3(g.normal, w.normal)) return "normal " + std::to_string(k) + " differs";
+    if (g.offset != w.offset || g.denominator != w.denominator)
+      return "offset " + std::to_string(k) + " differs";
+    if (g.source != w.source || g.element != w.element)
+      return "labels of " + std::to_string(k) + " differ";
+  }
+  if (got.hint.x != want.hint.x || got.hint.y != want.hint.y || got.hint.z != want.hint.z)
+    return "hints differ";
+  const KnownPoints &p = got.known, &q = want.known;
+  if (p.begin != q.begin || p.point != q.point) return "known incidences differ";
+  if (p.X.size() != q.X.size()) return "known point counts differ";
+  for (std::size_t k = 0; k < p.X.size(); ++k) {
+    if (!same3(p.X[k], q.X[k]) || p.W[k] != q.W[k]) return "known point " + std::to_string(k);
+    if (!same_interval(p.Xi[k].x, q.Xi[k].x) || !same_interval(p.Xi[k].y, q.Xi[k].y) ||
+        !same_interval(p.Xi[k].z, q.Xi[k].z) || !same_interval(p.Wi[k], q.Wi[k]))
+      return "enclosure of known point " + std::to_string(k);
+  }
+  if (got.expected.begin != want.expected.begin || got.expected.facets != want.expected.facets ||
+      got.expected.split != want.expected.split)
+    return "guesses differ";
+  return "";
+}
+
+// A closing's half-spaces come from A, B and the sum's facets (closing_input) without S:
+// the very half-spaces, known points, guess and hint that erode_sum makes from S, so the
+// same result. Elements off the origin, scaled by 2^+-200 or far from the origin, parallel
+// facets and edges summed into polygons (integer polytopes, a cube by a cube, an unturned
+// icosphere); nearly planar facets (the UV sphere's, a rotated cube's quads) go through S.
+TEST_CASE("halfspace_intersection: a closing from the sum's facets, without the sum") {
+  const auto sample = [](const std::string& name) {
+    return morph::read_mesh(std::string(MORPH_SAMPLES_DIR) + "/" + name);
+  };
+  using morph::test::scaled;
+  using morph::test::translated;
+  const morph::Mesh ball = scaled(sample("icosphere_80.off"), 0.25);
+  // Turned, so that none of its facets or edges is parallel to the icospheres'.
+  const morph::Mesh turned = morph::test::transformed(ball, morph::test::random_rotation(2));
+  struct Case {
+    std::string name;
+    morph::Mesh a, b;
+    int direct;  // whether closing_input takes it: 1 yes, 0 no (parallel or nearly planar
+                 // facets), -1 either
+  };
+  std::vector<Case> cases = {
+      {"icosphere_320 by a ball", sample("icosphere_320.off"), turned, 1},
+      {"icosphere_320 by a ball off the origin", sample("icosphere_320.off"),
+       translated(turned, {3, -2, 1.5}), 1},
+      {"icosphere_320 by an unturned ball", sample("icosphere_320.off"), ball, 1},
+      {"random_hull_200 by a rotated cube", sample("random_hull_200.off"),
+       morph::test::rotated_cube_triangles(0.3, 5), 1},
+      {"grid polytopes", morph::test::random_grid_polytope(60, 3),
+       translated(scaled(morph::test::random_grid_polytope(20, 4), 0.25), {0.5, 0.25, -2}), 1},
+      {"grid polytopes by 2^200", scaled(morph::test::random_grid_polytope(40, 5), 0x1p200),
+       scaled(morph::test::random_grid_polytope(12, 6), 0x1p198), 1},
+      {"grid polytopes by 2^-200", scaled(morph::test::random_grid_polytope(40, 7), 0x1p-200),
+       scaled(morph::test::random_grid_polytope(12, 8), 0x1p-202), 1},
+      {"far from the origin", translated(sample("icosphere_1280.off"), {3e4, -1e5, 7}),
+       translated(turned, {-2e3, 3, 5e3}), 1},
+      {"cylinder by a ball", sample("cylinder_16.off"), translated(ball, {0.1, 0.2, -0.3}), 1},
+      {"cube by a cube", sample("cube.off"), translated(morph::test::cube(0.5), {2, 2, 2}), 1},
+      {"integer polytopes", morph::test::random_integer_polytope(30, 11),
+       morph::test::random_integer_polytope(12, 12, 1), 1},
+      {"uvsphere_1600 by a ball", sample("uvsphere_1600.off"), turned, 0},
+      {"icosphere_320 by rotated quads", sample("icosphere_320.off"),
+       morph::test::rotated_cube_quads(0.3, 7), 0},
+  };
+  // Integer polytopes: parallel facets and edges, polygons, elements off the origin.
+  for (std::uint64_t seed = 20; seed < 26; ++seed)
+    cases.push_back({"integer polytopes, seed " + std::to_string(seed),
+                     morph::test::random_integer_polytope(24, seed),
+                     translated(morph::test::random_integer_polytope(10, seed + 100, 2),
+                                {double(seed % 3), -1, 5}),
+                     1});
+  for (const Case& c : cases) {
+    INFO(c.name);
+    const Polytope A = make_operand(c.a, "A"), B = make_operand(c.b, "B");
+    const SumFacets sum = fims_facets(A, B);
+    const Polytope S = sum_polytope(A, B, sum);
+    const ErosionInput want = erode_sum_input(S, A, B);
+    const std::optional<ErosionInput> got = closing_input(sum, A, B);
+    if (c.direct >= 0) CHECK(got.has_value() == (c.direct == 1));
+    if (got) CHECK(input_difference(*got, want) == "");
+    const MaybePolytope via_sum = erode_sum(sum, A, B), via_s = erode_sum(S, A, B);
+    CHECK(difference(via_sum, via_s) == "");
+    CHECK(via_sum.route == via_s.route);
+    CHECK(rounded_from_exact(via_sum));
+    CHECK(via_sum.rounded.face_element == via_s.rounded.face_element);
+  }
+}
+
 // An erosion by a small element is A with its facets moved in: each vertex of A whose
 // facets are moved by different vertices of B opens up into several vertices, which the
 // guess finds by flipping the triangulation of the vertex's polygon of planes. It is taken

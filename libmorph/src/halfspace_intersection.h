@@ -13,6 +13,8 @@
 
 namespace morph::detail {
 
+struct SumFacets;  // fims.h
+
 /// A closed half-space { x : <normal, x> <= offset / denominator }, exact. Dyadic offsets
 /// (polytopes with double or dyadic points) have denominator 1; a rational offset p/q is
 /// stored as offset p, denominator q (not necessarily reduced). `source` and `element` are carried
@@ -165,5 +167,28 @@ MaybePolytope erode_polytope(const Polytope& A, const Polytope& B,
 /// over A_i (S.sum_pairs).
 MaybePolytope erode_sum(const Polytope& S, const Polytope& A, const Polytope& B,
                         const IntersectOptions& options = {});
+
+/// The same closing from the facets of S = A (+) B (fims_facets(A, B)), without S: a facet
+/// of S is A's face plus B's face along its normal n, so its plane moved back by h_B(n) is
+/// <n, x> = <n, a_i> for any of its corners (a_i, b_j). The normals come from the operands
+/// (A's facet, B's facet, the cross product of an edge of each, or the Newell normal of the
+/// exact sums where parallel features were summed into one polygon), exactly the normals S
+/// would have, and the half-spaces, known points and guess are erode_sum's on S. When a facet
+/// of A or B is planar only within the tolerance, S may differ (merged facets): the closing
+/// goes through sum_polytope and erode_sum as before.
+MaybePolytope erode_sum(const SumFacets& sum, const Polytope& A, const Polytope& B,
+                        const IntersectOptions& options = {});
+
+/// What an erosion hands to intersect_halfspaces: for tests, which compare the closing's
+/// two routes (closing_input is empty where erode_sum(sum, ...) goes through S).
+struct ErosionInput {
+  std::vector<HalfSpace> halfspaces;
+  V3<double> hint{0, 0, 0};
+  KnownPoints known;
+  ExpectedVertices expected;
+};
+ErosionInput erode_sum_input(const Polytope& S, const Polytope& A, const Polytope& B);
+std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& A,
+                                          const Polytope& B);
 
 }  // namespace morph::detail

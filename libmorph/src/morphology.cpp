@@ -80,8 +80,7 @@ MorphResult close(const Mesh& A, const Mesh& B, const MorphologyOptions& options
   return detail::run_with_threads(options.threads, [&] {
     const Operands op = detail::make_operands(A, B);
     const detail::SumFacets sum = detail::fims_facets(op.a, op.b);
-    const Polytope s = detail::sum_polytope(op.a, op.b, sum);
-    const detail::MaybePolytope e = detail::erode_sum(s, op.a, op.b, kFinal);
+    const detail::MaybePolytope e = detail::erode_sum(sum, op.a, op.b, kFinal);
     if (e.reason != EmptyReason::none) return empty_result(e);
     // Each facet lies on a facet of A (+) B (its half-space's source): labelled as that one.
     return from_rounded(e.rounded, [&](int f) { return sum.origins[e.rounded.face_source[f]]; });
