@@ -143,11 +143,37 @@ bool strictly_inside(const std::vector<Plane>& planes, const V3<double>& o) {
   return inside;
 }
 
+/// A vertex of the intersection in homogeneous coordinates: X / W with W > 0, the meet
+/// of three of the planes. The exact coordinates are computed only where the filters
+/// (intervals, then double-double) cannot decide, or for a polytope chained further.
+struct HVertex {
+  std::array<int, 3> planes;
+  V3<Interval> Xi;
+  Interval Wi;
+  V3<Interval> xi;  // Xi / Wi
+  bool has_exact = false;
+  V3<ExactN> X;
+  ExactN W;
+  int known = -1;  // the known point it is (KnownPoints), if any
+  // X and W times some positive factor in double-double, within ex and ew of the exact
+  // ones times that factor (make_precise); only when `precise`.
+  V3<DD> px{};
+  DD pw{};
+  V3<double> ex{};
+  double ew = 0;
+  bool precise = false;
+  bool doubles = false;  // a known point X / 1 with X exactly doubles: its rounding is X
+};
+
 /// A candidate dual hull: triangles over plane indices, counter-clockwise seen from
 /// outside, and the triangle across each edge (edge k runs from corner k to corner k + 1).
+/// The vertex of a triangle's three planes (vertex_of, in the corners' order) may come
+/// with it, when the candidate's construction computed it already (has_vertex[t]).
 struct DualSurface {
   std::vector<std::array<int, 3>> corner;
   std::vector<std::array<int, 3>> across;
+  std::vector<HVertex> vertex;  // empty, or one per triangle
+  std::vector<char> has_vertex;
 };
 
 /// The triangles of a hull computed by CGAL; empty when it is not a closed triangulated
@@ -172,28 +198,6 @@ DualSurface surface_of(const HullMesh& hull, const IndexOf& index_of) {
   }
   return s;
 }
-
-/// A vertex of the intersection in homogeneous coordinates: X / W with W > 0, the meet
-/// of three of the planes. The exact coordinates are computed only where the filters
-/// (intervals, then double-double) cannot decide, or for a polytope chained further.
-struct HVertex {
-  std::array<int, 3> planes;
-  V3<Interval> Xi;
-  Interval Wi;
-  V3<Interval> xi;  // Xi / Wi
-  bool has_exact = false;
-  V3<ExactN> X;
-  ExactN W;
-  int known = -1;  // the known point it is (KnownPoints), if any
-  // X and W times some positive factor in double-double, within ex and ew of the exact
-  // ones times that factor (make_precise); only when `precise`.
-  V3<DD> px{};
-  DD pw{};
-  V3<double> ex{};
-  double ew = 0;
-  bool precise = false;
-  bool doubles = false;  // a known point X / 1 with X exactly doubles: its rounding is X
-};
 
 /// The point of three planes (Cramer's rule); W = det(n_a, n_b, n_c).
 template <class T>
@@ -459,6 +463,16 @@ class LazyExact {
   std::unique_ptr<std::once_flag[]> once_;
 };
 
+/// The double next to r away from zero (`outward`) or towards it, for a normal r far from
+/// overflow: one step of its bit pattern (what std::nextafter does, without the call).
+double step_from(double r, bool outward) {
+  std::uint64_t bits;
+  std::memcpy(&bits, &r, sizeof bits);
+  bits = outward ? bits + 1 : bits - 1;
+  std::memcpy(&r, &bits, sizeof bits);
+  return r;
+}
+
 /// X / W rounded to nearest (ties to even) from precise coordinates, when their enclosure
 /// lies strictly between two rounding midpoints (round-to-nearest); false otherwise (too
 /// close to a midpoint, or out of range): the exact rounding decides. X is within ex of
@@ -487,7 +501,7 @@ bool round_precise(const DD& X, double ex, const DD& W, double ew, double& out) 
   // (|W.lo| <= 2^-53 W.hi), and the half gaps are powers of two (products exact: no
   // underflow in this range).
   const double w_low = W.hi * (1 - 0x1p-50);
-  const double up = std::nextafter(r, HUGE_VAL) - r, down = r - std::nextafter(r, -HUGE_VAL);
+  const double up = step_from(r, r > 0) - r, down = r - step_from(r, r < 0);
   if (!(R + error < 0.5 * up * w_low && R - error > -0.5 * down * w_low)) return false;
   out = r;
   return true;
@@ -571,12 +585,26 @@ bool clockwise(const std::vector<int>& cyc, const std::vector<HVertex>& vertex,
   return CGAL::sign(dot(nw, to_rational(normal))) < 0;
 }
 
+/// Sorts each list list[begin[i] .. begin[i + 1]) and drops repeats in it, compacting.
+void sort_unique_lists(std::vector<int>& begin, std::vector<int>& list) {
+  int kept = 0;
+  for (std::size_t i = 0; i + 1 < begin.size(); ++i) {
+    const auto first = list.begin() + begin[i], last = list.begin() + begin[i + 1];
+    std::sort(first, last);
+    begin[i] = kept;
+    for (auto it = first; it != last; ++it)
+      if (it == first || *it != *(it - 1)) list[kept++] = *it;
+  }
+  begin.back() = kept;
+  list.resize(kept);
+}
+
 /// Builds the intersection from a candidate dual hull, checking exactly that it is the
 /// dual hull of all the planes; nullopt when it is not. The result has `rounded`, and
 /// `polytope` when `with_polytope`.
 std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
                                             const std::vector<Plane>& planes,
-                                            const KnownPoints& known, const DualSurface& s,
+                                            const KnownPoints& known, DualSurface s,
                                             bool with_polytope) {
   const int nt = static_cast<int>(s.corner.size());
   const int n = static_cast<int>(planes.size());
@@ -624,6 +652,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   // the vertex is degenerate: the filter cannot show a zero).
   std::vector<int> group(nt, -1), seed;
   std::vector<HVertex> vertex;
+  vertex.reserve(nt);
   {
     RoundingGuard guard;
     std::vector<int> stack, through;
@@ -631,7 +660,10 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       if (group[t0] >= 0) continue;
       const int g = static_cast<int>(seed.size());
       seed.push_back(t0);
-      vertex.push_back(vertex_of(planes, s.corner[t0], known));
+      if (!s.has_vertex.empty() && s.has_vertex[t0])
+        vertex.push_back(std::move(s.vertex[t0]));
+      else
+        vertex.push_back(vertex_of(planes, s.corner[t0], known));
       through.assign(s.corner[t0].begin(), s.corner[t0].end());
       group[t0] = g;
       stack.assign(1, t0);
@@ -664,44 +696,52 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     }
   }
   const int nv = static_cast<int>(vertex.size());
-  // The vertex graph (edges between groups).
+  // The vertex graph (edges between groups): each vertex's neighbours in increasing order,
+  // once (a counting pass by vertex, then each short list sorted).
   std::vector<int> adj_begin(nv + 1, 0), adj;
   {
-    std::vector<std::pair<int, int>> links;
     for (int t = 0; t < nt; ++t)
       for (int k = 0; k < 3; ++k)
-        if (group[s.across[t][k]] != group[t]) links.emplace_back(group[t], group[s.across[t][k]]);
-    std::sort(links.begin(), links.end());
-    links.erase(std::unique(links.begin(), links.end()), links.end());
-    for (const auto& l : links) ++adj_begin[l.first + 1];
-    for (int v = 0; v < nv; ++v) adj_begin[v + 1] += adj_begin[v];
-    for (const auto& l : links) adj.push_back(l.second);
+        if (group[s.across[t][k]] != group[t]) ++adj_begin[group[t] + 1];
+    std::partial_sum(adj_begin.begin(), adj_begin.end(), adj_begin.begin());
+    adj.resize(adj_begin[nv]);
+    std::vector<int> next(adj_begin.begin(), adj_begin.end() - 1);
+    for (int t = 0; t < nt; ++t)
+      for (int k = 0; k < 3; ++k)
+        if (group[s.across[t][k]] != group[t]) adj[next[group[t]]++] = group[s.across[t][k]];
+    sort_unique_lists(adj_begin, adj);
   }
   // Facets: dual vertices with at least three groups around them (others lie on a dual
   // edge or facet: their planes only touch the intersection).
   std::vector<int> some_triangle(n, -1);
   for (int t = 0; t < nt; ++t)
     for (int k = 0; k < 3; ++k) some_triangle[s.corner[t][k]] = t;
-  std::vector<std::vector<int>> faces;
-  std::vector<int> face_halfspace;
+  // Facet f's cycle of vertices is face_vertex[face_begin[f] .. face_begin[f + 1]).
+  std::vector<int> face_begin(1, 0), face_vertex, face_halfspace;
+  face_vertex.reserve(3 * static_cast<std::size_t>(nt));
   for (int p = 0; p < n; ++p) {
     if (some_triangle[p] < 0) continue;
-    std::vector<int> cyc;
+    const std::size_t start = face_vertex.size();
     int t = some_triangle[p], steps = 0;
     do {
       const int g = group[t];
-      if (cyc.empty() || cyc.back() != g) cyc.push_back(g);
+      if (face_vertex.size() == start || face_vertex.back() != g) face_vertex.push_back(g);
       int k = 0;
       while (k < 3 && s.corner[t][k] != p) ++k;
       if (k == 3 || ++steps > nt) return std::nullopt;
       t = s.across[t][k];
     } while (t != some_triangle[p]);
-    while (cyc.size() > 1 && cyc.front() == cyc.back()) cyc.pop_back();
-    if (cyc.size() < 3) continue;
-    faces.push_back(std::move(cyc));
+    while (face_vertex.size() > start + 1 && face_vertex[start] == face_vertex.back())
+      face_vertex.pop_back();
+    if (face_vertex.size() < start + 3) {
+      face_vertex.resize(start);
+      continue;
+    }
+    face_begin.push_back(static_cast<int>(face_vertex.size()));
     face_halfspace.push_back(p);
   }
-  if (faces.size() < 4) return std::nullopt;
+  const int nf = static_cast<int>(face_halfspace.size());
+  if (nf < 4) return std::nullopt;
   // Precise vertices, for the checks below (a second filter stage) and the rounding; exact
   // ones only where those cannot decide (LazyExact), but all of them for a polytope that is
   // computed with further.
@@ -770,53 +810,85 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     }
   });
   if (!ok) return std::nullopt;
-  // Verified. The half-spaces through each vertex: those of its triangles and the
-  // touching ones. A touching plane along a whole facet is that facet's plane given twice:
-  // the facet takes the smaller index.
-  std::vector<std::vector<int>> key(nv);
-  for (int t = 0; t < nt; ++t)
-    key[group[t]].insert(key[group[t]].end(), s.corner[t].begin(), s.corner[t].end());
+  // Verified. The half-spaces through each vertex (key[key_begin[v] ..), sorted, once):
+  // those of its triangles and the touching ones. A touching plane along a whole facet is
+  // that facet's plane given twice: the facet takes the smaller index.
+  std::vector<int> key_begin(nv + 1, 0), key;
+  for (int t = 0; t < nt; ++t) key_begin[group[t] + 1] += 3;
+  for (const auto& plateau : touched)
+    for (int v : plateau) ++key_begin[v + 1];
+  std::partial_sum(key_begin.begin(), key_begin.end(), key_begin.begin());
+  key.resize(key_begin[nv]);
+  {
+    std::vector<int> next(key_begin.begin(), key_begin.end() - 1);
+    for (int t = 0; t < nt; ++t)
+      for (int a : s.corner[t]) key[next[group[t]]++] = a;
+    for (std::size_t j = 0; j < others.size(); ++j)
+      for (int v : touched[j]) key[next[v]++] = others[j];
+  }
+  sort_unique_lists(key_begin, key);
   for (std::size_t j = 0; j < others.size(); ++j) {
-    for (int v : touched[j]) key[v].push_back(others[j]);
     if (touched[j].size() < 3) continue;
-    for (std::size_t f = 0; f < faces.size(); ++f) {
-      std::vector<int> cyc = faces[f];
+    for (int f = 0; f < nf; ++f) {
+      if (face_begin[f + 1] - face_begin[f] != static_cast<int>(touched[j].size())) continue;
+      std::vector<int> cyc(face_vertex.begin() + face_begin[f],
+                           face_vertex.begin() + face_begin[f + 1]);
       std::sort(cyc.begin(), cyc.end());
       if (cyc == touched[j]) face_halfspace[f] = std::min(face_halfspace[f], others[j]);
     }
   }
-  for (auto& k : key) {
-    std::sort(k.begin(), k.end());
-    k.erase(std::unique(k.begin(), k.end()), k.end());
-  }
   // Number vertices and facets canonically (hull orders depend on CGAL's internal
   // shuffling): a vertex by the sorted half-spaces through it, a facet by its half-space,
   // each cycle starting at its smallest vertex. The output then depends only on the input.
+  // Both orders are strict (no two vertices have the same half-spaces, no two facets the
+  // same one), so bucket passes give them: vertices by their smallest half-space, each
+  // bucket (a few vertices) then sorted by the whole list.
   std::vector<int> order(nv), rank(nv);
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](int a, int b) { return key[a] < key[b]; });
-  for (int r = 0; r < nv; ++r) rank[order[r]] = r;
-  std::vector<int> forder(faces.size());
-  std::iota(forder.begin(), forder.end(), 0);
-  std::sort(forder.begin(), forder.end(),
-            [&](int a, int b) { return face_halfspace[a] < face_halfspace[b]; });
-  std::vector<std::vector<int>> sorted_faces;
-  std::vector<int> sorted_halfspace;
-  for (int f : forder) {
-    auto cyc = faces[f];
-    for (int& g : cyc) g = rank[g];
-    std::rotate(cyc.begin(), std::min_element(cyc.begin(), cyc.end()), cyc.end());
-    sorted_faces.push_back(std::move(cyc));
-    sorted_halfspace.push_back(face_halfspace[f]);
+  {
+    std::vector<int> bucket(n + 1, 0);
+    for (int v = 0; v < nv; ++v) ++bucket[key[key_begin[v]] + 1];
+    std::partial_sum(bucket.begin(), bucket.end(), bucket.begin());
+    std::vector<int> next(bucket.begin(), bucket.end() - 1);
+    for (int v = 0; v < nv; ++v) order[next[key[key_begin[v]]]++] = v;
+    const auto key_less = [&](int a, int b) {
+      return std::lexicographical_compare(
+          key.begin() + key_begin[a], key.begin() + key_begin[a + 1], key.begin() + key_begin[b],
+          key.begin() + key_begin[b + 1]);
+    };
+    for (int p = 0; p < n; ++p)
+      if (bucket[p + 1] - bucket[p] > 1)
+        std::sort(order.begin() + bucket[p], order.begin() + bucket[p + 1], key_less);
   }
-  faces = std::move(sorted_faces);
-  face_halfspace = std::move(sorted_halfspace);
+  for (int r = 0; r < nv; ++r) rank[order[r]] = r;
+  {
+    std::vector<int> facet_of(n, -1);  // by half-space
+    for (int f = 0; f < nf; ++f) facet_of[face_halfspace[f]] = f;
+    std::vector<int> sorted_begin(1, 0), sorted_vertex, sorted_halfspace;
+    sorted_vertex.reserve(face_vertex.size());
+    sorted_halfspace.reserve(nf);
+    for (int p = 0; p < n; ++p) {
+      const int f = facet_of[p];
+      if (f < 0) continue;
+      const auto first = sorted_vertex.end() - sorted_vertex.begin();
+      for (int j = face_begin[f]; j < face_begin[f + 1]; ++j)
+        sorted_vertex.push_back(rank[face_vertex[j]]);
+      std::rotate(sorted_vertex.begin() + first,
+                  std::min_element(sorted_vertex.begin() + first, sorted_vertex.end()),
+                  sorted_vertex.end());
+      sorted_begin.push_back(static_cast<int>(sorted_vertex.size()));
+      sorted_halfspace.push_back(p);
+    }
+    face_begin = std::move(sorted_begin);
+    face_vertex = std::move(sorted_vertex);
+    face_halfspace = std::move(sorted_halfspace);
+  }
   // Circulating around a dual vertex may run clockwise: orient by the first facet.
   {
-    std::vector<int> cyc = faces[0];
+    std::vector<int> cyc(face_vertex.begin(), face_vertex.begin() + face_begin[1]);
     for (int& r : cyc) r = order[r];
     if (clockwise(cyc, vertex, hs[face_halfspace[0]].normal, exact_vertex))
-      for (auto& c : faces) std::reverse(c.begin(), c.end());
+      for (int f = 0; f < nf; ++f)
+        std::reverse(face_vertex.begin() + face_begin[f], face_vertex.begin() + face_begin[f + 1]);
   }
   // Rounded vertices, exactly rounded from the homogeneous coordinates: from the precise
   // ones unless they lie too close to a rounding midpoint, from the exact ones then;
@@ -852,13 +924,19 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       exact.enclosure[r] = v.xi;
     }
   });
-  rp.face_begin.assign(1, 0);
-  for (std::size_t f = 0; f < faces.size(); ++f) {
-    rp.corner_vertex.insert(rp.corner_vertex.end(), faces[f].begin(), faces[f].end());
-    rp.face_begin.push_back(static_cast<int>(rp.corner_vertex.size()));
-    rp.face_source.push_back(hs[face_halfspace[f]].source);
-    rp.face_element.push_back(hs[face_halfspace[f]].element);
+  rp.face_source.resize(nf);
+  rp.face_element.resize(nf);
+  for (int f = 0; f < nf; ++f) {
+    rp.face_source[f] = hs[face_halfspace[f]].source;
+    rp.face_element[f] = hs[face_halfspace[f]].element;
   }
+  std::vector<std::vector<int>> faces;  // for a polytope
+  if (with_polytope)
+    for (int f = 0; f < nf; ++f)
+      faces.emplace_back(face_vertex.begin() + face_begin[f],
+                         face_vertex.begin() + face_begin[f + 1]);
+  rp.face_begin = std::move(face_begin);
+  rp.corner_vertex = std::move(face_vertex);
   if (with_polytope) {
     std::vector<V3<ExactN>> normals(faces.size());
     for (std::size_t f = 0; f < faces.size(); ++f) normals[f] = hs[face_halfspace[f]].normal;
@@ -1208,9 +1286,11 @@ constexpr int kFlipsPerCorner = 4;
 /// triangle is not positively oriented, the flips take more than kFlipsPerCorner k (the
 /// guess is then likely wrong, and the hull is computed; a triangle never tested is left to
 /// the check), or the polygon would split and `split` is false (ExpectedVertices::split).
+/// The vertices it computed of the final triangles go to out_vertex (out_has set).
 /// Needs a RoundingGuard.
 bool triangulate_polygon(const std::vector<Plane>& planes, const KnownPoints& known, const int* p,
-                         int k, bool split, std::array<int, 3>* out, PolygonScratch& scratch) {
+                         int k, bool split, std::array<int, 3>* out, HVertex* out_vertex,
+                         char* out_has, PolygonScratch& scratch) {
   // Planes through one known point (facets of A moved by one vertex of B): one vertex.
   if (k == 3 || common_point(known, p, k) >= 0) {
     for (int i = 1; i + 1 < k; ++i) out[i - 1] = {p[0], p[i], p[i + 1]};
@@ -1265,8 +1345,12 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const KnownPoints& kn
     for (const auto& e : {std::pair(a, d), std::pair(d, c), std::pair(c, b), std::pair(b, a)})
       if (diagonal(e.first, e.second)) pending.push_back(e);
   }
-  for (std::size_t t = 0; t < triangle.size(); ++t)
+  for (std::size_t t = 0; t < triangle.size(); ++t) {
     out[t] = {p[triangle[t][0]], p[triangle[t][1]], p[triangle[t][2]]};
+    if (!ready[t]) continue;
+    out_vertex[t] = std::move(vertex[t]);
+    out_has[t] = 1;
+  }
   return true;
 }
 
@@ -1286,6 +1370,8 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const KnownPoints
   }
   const int nt = first[nv];
   s.corner.resize(nt);
+  s.vertex.resize(nt);
+  s.has_vertex.assign(nt, 0);
   std::atomic<bool> ok = true;
   parallel_chunks(nv, 64, [&](int begin, int end) {
     RoundingGuard guard;
@@ -1293,7 +1379,8 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const KnownPoints
     for (int v = begin; v < end && ok; ++v)
       if (!triangulate_polygon(planes, known, &expected.facets[expected.begin[v]],
                                expected.begin[v + 1] - expected.begin[v], expected.split,
-                               &s.corner[first[v]], scratch))
+                               &s.corner[first[v]], &s.vertex[first[v]], &s.has_vertex[first[v]],
+                               scratch))
         ok = false;
   });
   if (!ok) return {};
@@ -1370,7 +1457,7 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
       const auto outcome = IncrementalHull(planes, known, o_double, reach).run(s);
       if (outcome == IncrementalHull::Outcome::too_small) continue;
       if (outcome == IncrementalHull::Outcome::hull) {
-        if (auto built = build_verified(hs, planes, known, s, options.polytope)) {
+        if (auto built = build_verified(hs, planes, known, std::move(s), options.polytope)) {
           built->route = HullRoute::incremental;
           return std::move(*built);
         }
