@@ -199,14 +199,21 @@ DualSurface surface_of(const HullMesh& hull, const IndexOf& index_of) {
   return s;
 }
 
+/// The point of three planes (Cramer's rule) from the cross products of their normals,
+/// bc = n_b x n_c, ca = n_c x n_a, ab = n_a x n_b; W = det(n_a, n_b, n_c).
+template <class T>
+void meet_of_crosses(const V3<T>& na, const T& da, const T& db, const T& dc, const V3<T>& bc,
+                     const V3<T>& ca, const V3<T>& ab, V3<T>& X, T& W) {
+  W = dot(na, bc);
+  X = {da * bc.x + db * ca.x + dc * ab.x, da * bc.y + db * ca.y + dc * ab.y,
+       da * bc.z + db * ca.z + dc * ab.z};
+}
+
 /// The point of three planes (Cramer's rule); W = det(n_a, n_b, n_c).
 template <class T>
 void meet(const V3<T>& na, const T& da, const V3<T>& nb, const T& db, const V3<T>& nc, const T& dc,
           V3<T>& X, T& W) {
-  const V3<T> bc = cross(nb, nc), ca = cross(nc, na), ab = cross(na, nb);
-  W = dot(na, bc);
-  X = {da * bc.x + db * ca.x + dc * ab.x, da * bc.y + db * ca.y + dc * ab.y,
-       da * bc.z + db * ca.z + dc * ab.z};
+  meet_of_crosses(na, da, db, dc, cross(nb, nc), cross(nc, na), cross(na, nb), X, W);
 }
 
 /// The interval vertex of three planes (needs a RoundingGuard).
@@ -321,10 +328,33 @@ PrecisePlane precise_plane(const Plane& plane) {
 V3<DD> normal_dd(const PrecisePlane& p) { return {p.c[0], p.c[1], p.c[2]}; }
 V3<Magnitude> normal_magnitude(const PrecisePlane& p) { return magnitude(normal_dd(p)); }
 
+/// The precise meet of valid planes a, b, c (round-to-nearest) from their normals' cross
+/// products bc, ca, ab in double-double, each as `cross` evaluates it or that negated (the
+/// same value of the opposite edge, n_b x n_a = -(n_a x n_b): negation is exact, so the
+/// bound below holds alike).
+void precise_meet(const PrecisePlane& a, const PrecisePlane& b, const PrecisePlane& c,
+                  const V3<DD>& bc, const V3<DD>& ca, const V3<DD>& ab, HVertex& v) {
+  meet_of_crosses(normal_dd(a), a.c[3], b.c[3], c.c[3], bc, ca, ab, v.px, v.pw);
+  V3<Magnitude> mx;
+  Magnitude mw;
+  meet(normal_magnitude(a), magnitude(a.c[3]), normal_magnitude(b), magnitude(b.c[3]),
+       normal_magnitude(c), magnitude(c.c[3]), mx, mw);
+  // Degree 3 in the planes' components; underflow in the cross products is multiplied by
+  // at most |d| (no overflow: |n| < 2, |d| <= 2^400).
+  constexpr double factor = (3 * kPlaneRelative + kEvaluation) * 1.01;
+  const double absolute =
+      0x1p-960 * (1 + std::abs(a.c[3].hi) + std::abs(b.c[3].hi) + std::abs(c.c[3].hi));
+  v.ex = {factor * mx.x.v + absolute, factor * mx.y.v + absolute, factor * mx.z.v + absolute};
+  v.ew = factor * mw.v + 0x1p-960;
+  v.precise = true;
+}
+
 /// The precise coordinates of a vertex (round-to-nearest): a known point's from its exact
-/// ones (W in [1, 2)), another's as the meet of its precise planes. Left out when a plane
-/// is not valid or a value out of range.
-void make_precise(const std::vector<PrecisePlane>& planes, HVertex& v) {
+/// ones (W in [1, 2)), another's as the meet of its precise planes (`crosses`: their
+/// normals' cross products bc, ca, ab when the caller has them, as in precise_meet). Left
+/// out when a plane is not valid or a value out of range.
+void make_precise(const std::vector<PrecisePlane>& planes, HVertex& v,
+                  const std::array<V3<DD>, 3>* crosses = nullptr) {
   if (v.known >= 0) {
     const auto is_double = [](const ExactN& x) {
       const double d = x.to_double();
@@ -344,19 +374,12 @@ void make_precise(const std::vector<PrecisePlane>& planes, HVertex& v) {
   }
   const PrecisePlane &a = planes[v.planes[0]], &b = planes[v.planes[1]], &c = planes[v.planes[2]];
   if (!a.valid || !b.valid || !c.valid) return;
-  meet(normal_dd(a), a.c[3], normal_dd(b), b.c[3], normal_dd(c), c.c[3], v.px, v.pw);
-  V3<Magnitude> mx;
-  Magnitude mw;
-  meet(normal_magnitude(a), magnitude(a.c[3]), normal_magnitude(b), magnitude(b.c[3]),
-       normal_magnitude(c), magnitude(c.c[3]), mx, mw);
-  // Degree 3 in the planes' components; underflow in the cross products is multiplied by
-  // at most |d| (no overflow: |n| < 2, |d| <= 2^400).
-  constexpr double factor = (3 * kPlaneRelative + kEvaluation) * 1.01;
-  const double absolute =
-      0x1p-960 * (1 + std::abs(a.c[3].hi) + std::abs(b.c[3].hi) + std::abs(c.c[3].hi));
-  v.ex = {factor * mx.x.v + absolute, factor * mx.y.v + absolute, factor * mx.z.v + absolute};
-  v.ew = factor * mw.v + 0x1p-960;
-  v.precise = true;
+  if (crosses) {
+    precise_meet(a, b, c, (*crosses)[0], (*crosses)[1], (*crosses)[2], v);
+    return;
+  }
+  const V3<DD> na = normal_dd(a), nb = normal_dd(b), nc = normal_dd(c);
+  precise_meet(a, b, c, cross(nb, nc), cross(nc, na), cross(na, nb), v);
 }
 
 /// Sign of <n, X> - d W from the precise stage, or 2 (round-to-nearest; both precise).
@@ -585,15 +608,21 @@ bool clockwise(const std::vector<int>& cyc, const std::vector<HVertex>& vertex,
   return CGAL::sign(dot(nw, to_rational(normal))) < 0;
 }
 
-/// Sorts each list list[begin[i] .. begin[i + 1]) and drops repeats in it, compacting.
+/// Sorts each list list[begin[i] .. begin[i + 1]) and drops repeats in it, compacting (the
+/// lists are short: an insertion sort).
 void sort_unique_lists(std::vector<int>& begin, std::vector<int>& list) {
   int kept = 0;
   for (std::size_t i = 0; i + 1 < begin.size(); ++i) {
-    const auto first = list.begin() + begin[i], last = list.begin() + begin[i + 1];
-    std::sort(first, last);
+    const int first = begin[i], last = begin[i + 1];
+    for (int j = first + 1; j < last; ++j) {
+      const int x = list[j];
+      int m = j;
+      for (; m > first && list[m - 1] > x; --m) list[m] = list[m - 1];
+      list[m] = x;
+    }
     begin[i] = kept;
-    for (auto it = first; it != last; ++it)
-      if (it == first || *it != *(it - 1)) list[kept++] = *it;
+    for (int j = first; j < last; ++j)
+      if (j == first || list[j] != list[j - 1]) list[kept++] = list[j];
   }
   begin.back() = kept;
   list.resize(kept);
@@ -758,10 +787,58 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
         if (used[i]) precise[i] = precise_plane(planes[i]);
     });
   }
+  // The cross products of precise normals along the edges of the triangles that give the
+  // vertices (`seed`, when made from valid planes): an edge between two such triangles is
+  // computed once, by the smaller one, and taken negated by the other.
+  std::vector<char> from_planes(nt, 0);
+  for (int v = 0; v < nv; ++v) {
+    const HVertex& x = vertex[v];
+    from_planes[seed[v]] = x.known < 0 && x.planes == s.corner[seed[v]] &&
+                           precise[x.planes[0]].valid && precise[x.planes[1]].valid &&
+                           precise[x.planes[2]].valid;
+  }
+  std::vector<V3<DD>> edge_cross(3 * static_cast<std::size_t>(nt));
+  const auto shared = [&](int t, int k) {
+    const int u = s.across[t][k];
+    return from_planes[u] && u < t;
+  };
   parallel_chunks(nv, 128, [&](int begin, int end) {
     CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
     for (int v = begin; v < end; ++v) {
-      make_precise(precise, vertex[v]);
+      const int t = seed[v];
+      if (!from_planes[t]) continue;
+      for (int k = 0; k < 3; ++k)
+        if (!shared(t, k))
+          edge_cross[3 * t + k] = cross(normal_dd(precise[s.corner[t][k]]),
+                                        normal_dd(precise[s.corner[t][k == 2 ? 0 : k + 1]]));
+    }
+  });
+  parallel_chunks(nv, 128, [&](int begin, int end) {
+    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    for (int v = begin; v < end; ++v) {
+      const int t = seed[v];
+      if (!from_planes[t]) {
+        make_precise(precise, vertex[v]);
+      } else {
+        // Edge k runs from corner k to corner k + 1: ab, bc, ca for k = 0, 1, 2.
+        std::array<V3<DD>, 3> along;
+        for (int k = 0; k < 3; ++k) {
+          along[k] = edge_cross[3 * t + k];
+          if (!shared(t, k)) continue;
+          const int u = s.across[t][k], a = s.corner[t][k], b = s.corner[t][k == 2 ? 0 : k + 1];
+          int j = 0;
+          while (j < 3 && s.corner[u][j == 2 ? 0 : j + 1] != a) ++j;
+          // u's edge j is b -> a, across from t (an oriented surface), so u computed it.
+          if (j < 3 && s.corner[u][j] == b && s.across[u][j] == t) {
+            const V3<DD>& c = edge_cross[3 * u + j];
+            along[k] = {-c.x, -c.y, -c.z};
+          } else {
+            along[k] = cross(normal_dd(precise[a]), normal_dd(precise[b]));
+          }
+        }
+        const std::array<V3<DD>, 3> crosses{along[1], along[2], along[0]};
+        make_precise(precise, vertex[v], &crosses);
+      }
       if (with_polytope) make_exact(planes, vertex[v]);
     }
   });
