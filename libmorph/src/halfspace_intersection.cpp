@@ -226,14 +226,12 @@ HVertex vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& ab
   return v;
 }
 
-/// The vertex of three planes, taken from a known point when the three pass through one
-/// (and their normals are independent: the meet is then that point).
-HVertex vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& abc,
-                  const KnownPoints& known) {
-  HVertex v = vertex_of(planes, abc);
-  if (known.empty() || !(v.Wi.inf() > 0)) return v;
-  const int k = known.common(abc[0], abc[1], abc[2]);
-  if (k < 0) return v;
+/// A vertex of three planes taken from a known point when the three pass through one (and
+/// their normals are independent: the meet is then that point).
+void take_known(const KnownPoints& known, HVertex& v) {
+  if (known.empty() || !(v.Wi.inf() > 0)) return;
+  const int k = known.common(v.planes[0], v.planes[1], v.planes[2]);
+  if (k < 0) return;
   v.known = k;
   v.Xi = known.Xi[k];
   v.Wi = known.Wi[k];
@@ -241,6 +239,12 @@ HVertex vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& ab
   v.X = known.X[k];
   v.W = known.W[k];
   v.has_exact = true;
+}
+/// The vertex of three planes, from a known point where there is one (take_known).
+HVertex vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& abc,
+                  const KnownPoints& known) {
+  HVertex v = vertex_of(planes, abc);
+  take_known(known, v);
   return v;
 }
 
@@ -1344,9 +1348,10 @@ int common_point(const KnownPoints& known, const int* p, int k) {
 /// Scratch space of triangulate_polygon, kept across the polygons of a chunk.
 struct PolygonScratch {
   std::vector<std::array<int, 3>> triangle;  // corners: positions in the polygon
-  std::vector<HVertex> vertex;               // each triangle's vertex, once tested
-  std::vector<char> ready;                   // whether it is computed
+  std::vector<char> ready;                   // whether its vertex is computed
   std::vector<std::pair<int, int>> pending;  // diagonals to test
+  std::vector<V3<Interval>> cross;           // n_i x n_j of positions i, j (k i + j)
+  std::vector<char> has_cross;
 };
 
 /// Flips per corner after which a polygon's triangulation gives up: Lawson's flips may
@@ -1363,7 +1368,8 @@ constexpr int kFlipsPerCorner = 4;
 /// triangle is not positively oriented, the flips take more than kFlipsPerCorner k (the
 /// guess is then likely wrong, and the hull is computed; a triangle never tested is left to
 /// the check), or the polygon would split and `split` is false (ExpectedVertices::split).
-/// The vertices it computed of the final triangles go to out_vertex (out_has set).
+/// When it splits the polygon, each final triangle's vertex is in out_vertex (out_has set;
+/// it is the flips' scratch space on the way).
 /// Needs a RoundingGuard.
 bool triangulate_polygon(const std::vector<Plane>& planes, const KnownPoints& known, const int* p,
                          int k, bool split, std::array<int, 3>* out, HVertex* out_vertex,
@@ -1375,7 +1381,7 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const KnownPoints& kn
   }
   if (!split) return false;
   auto& triangle = scratch.triangle;
-  auto& vertex = scratch.vertex;
+  HVertex* vertex = out_vertex;  // each triangle's vertex, computed where it is ready
   auto& ready = scratch.ready;
   auto& pending = scratch.pending;
   triangle.clear();
@@ -1384,15 +1390,43 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const KnownPoints& kn
     triangle.push_back({0, i, i + 1});
     if (i > 1) pending.emplace_back(0, i);
   }
-  vertex.resize(triangle.size());
   ready.assign(triangle.size(), 0);
+  scratch.cross.resize(static_cast<std::size_t>(k) * k);
+  scratch.has_cross.assign(static_cast<std::size_t>(k) * k, 0);
+  // The cross product of the interval normals of positions i and j, computed once for
+  // both orders (n_j x n_i is its exact negation: the same intervals as computed afresh).
+  const auto cross_of = [&](int i, int j) -> const V3<Interval>& {
+    V3<Interval>& c = scratch.cross[i * k + j];
+    if (scratch.has_cross[i * k + j]) return c;
+    if (scratch.has_cross[j * k + i]) {
+      const V3<Interval>& r = scratch.cross[j * k + i];
+      c = {-r.x, -r.y, -r.z};
+    } else {
+      c = cross(planes[p[i]].ni, planes[p[j]].ni);
+    }
+    scratch.has_cross[i * k + j] = 1;
+    return c;
+  };
+  // Triangle t's vertex, as vertex_of(planes, abc, known) computes it.
+  const auto compute_vertex = [&](int t) {
+    ready[t] = 1;
+    const auto [i, j, l] = triangle[t];
+    HVertex& v = vertex[t];  // fresh, or a flipped triangle's: drop what that one had
+    v.has_exact = false;
+    v.known = -1;
+    v.planes = {p[i], p[j], p[l]};
+    const Plane &a = planes[p[i]], &b = planes[p[j]], &c = planes[p[l]];
+    meet_of_crosses(a.ni, a.di, b.di, c.di, cross_of(j, l), cross_of(l, i), cross_of(i, j), v.Xi,
+                    v.Wi);
+    v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
+    take_known(known, v);
+  };
   // Triangle t's vertex (computed when first tested); false when t is not positively
   // oriented.
   const auto make_vertex = [&](int t) {
     if (ready[t]) return true;
-    ready[t] = 1;
-    const std::array<int, 3> abc{p[triangle[t][0]], p[triangle[t][1]], p[triangle[t][2]]};
-    vertex[t] = vertex_of(planes, abc, known);
+    compute_vertex(t);
+    const std::array<int, 3>& abc = vertex[t].planes;
     return vertex[t].Wi.inf() > 0 || det_sign(planes[abc[0]], planes[abc[1]], planes[abc[2]]) > 0;
   };
   // The triangle holding the directed edge a -> c and that edge's slot in it, or -1.
@@ -1422,10 +1456,11 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const KnownPoints& kn
     for (const auto& e : {std::pair(a, d), std::pair(d, c), std::pair(c, b), std::pair(b, a)})
       if (diagonal(e.first, e.second)) pending.push_back(e);
   }
+  // Every final triangle's vertex, for the check (the untested ones cheaply, from the
+  // cross products at hand; their orientation is left to the check).
   for (std::size_t t = 0; t < triangle.size(); ++t) {
     out[t] = {p[triangle[t][0]], p[triangle[t][1]], p[triangle[t][2]]};
-    if (!ready[t]) continue;
-    out_vertex[t] = std::move(vertex[t]);
+    if (!ready[t]) compute_vertex(static_cast<int>(t));
     out_has[t] = 1;
   }
   return true;
