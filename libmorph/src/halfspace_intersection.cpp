@@ -680,44 +680,57 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   }
   // Group triangles whose planes meet in one point (exactly coplanar dual triangles):
   // each group is a vertex of the intersection. Every edge between groups must be
-  // strictly convex: the far plane of each neighbour is strictly satisfied. The planes
-  // found through the group's vertex are kept, so each is tested once (exactly, when
-  // the vertex is degenerate: the filter cannot show a zero).
+  // strictly convex: the far plane of each neighbour is strictly satisfied. Each far plane
+  // is tested at the triangle's own vertex, in parallel: a triangle that joins a group has
+  // its three planes through the group's point (two shared with a member, the far one
+  // tested there), with independent normals (det > 0 above), so its vertex is that point
+  // and the signs are the group's.
+  if (s.has_vertex.empty()) {
+    s.vertex.resize(nt);
+    s.has_vertex.assign(nt, 0);
+  }
+  std::vector<signed char> far_side(3 * static_cast<std::size_t>(nt));
+  parallel_chunks(nt, 256, [&](int begin, int end) {
+    RoundingGuard guard;
+    for (int t = begin; t < end && ok; ++t) {
+      HVertex& v = s.vertex[t];
+      if (!s.has_vertex[t]) {
+        v = vertex_of(planes, s.corner[t], known);
+        s.has_vertex[t] = 1;
+      }
+      for (int k = 0; k < 3; ++k) {
+        const auto& cn = s.corner[s.across[t][k]];
+        const int a = s.corner[t][k], b = s.corner[t][(k + 1) % 3];
+        int far = -1;
+        for (int j = 0; j < 3; ++j)
+          if (cn[j] != a && cn[j] != b) far = cn[j];
+        const int sd = far < 0                        ? 1
+                       : known_through(known, far, v) ? 0
+                                                      : side(planes, planes[far], v);
+        if (sd > 0) ok = false;
+        far_side[3 * t + k] = static_cast<signed char>(sd);
+      }
+    }
+  });
+  if (!ok) return std::nullopt;
   std::vector<int> group(nt, -1), seed;
   std::vector<HVertex> vertex;
   vertex.reserve(nt);
   {
-    RoundingGuard guard;
-    std::vector<int> stack, through;
+    std::vector<int> stack;
     for (int t0 = 0; t0 < nt; ++t0) {
       if (group[t0] >= 0) continue;
       const int g = static_cast<int>(seed.size());
       seed.push_back(t0);
-      if (!s.has_vertex.empty() && s.has_vertex[t0])
-        vertex.push_back(std::move(s.vertex[t0]));
-      else
-        vertex.push_back(vertex_of(planes, s.corner[t0], known));
-      through.assign(s.corner[t0].begin(), s.corner[t0].end());
+      vertex.push_back(std::move(s.vertex[t0]));
       group[t0] = g;
       stack.assign(1, t0);
       while (!stack.empty()) {
         const int t = stack.back();
         stack.pop_back();
         for (int k = 0; k < 3; ++k) {
+          if (far_side[3 * t + k] < 0) continue;
           const int nb = s.across[t][k];
-          const auto& cn = s.corner[nb];
-          const int a = s.corner[t][k], b = s.corner[t][(k + 1) % 3];
-          int far = -1;
-          for (int j = 0; j < 3; ++j)
-            if (cn[j] != a && cn[j] != b) far = cn[j];
-          if (far < 0) return std::nullopt;
-          const bool seen = std::find(through.begin(), through.end(), far) != through.end();
-          const int sd = seen || known_through(known, far, vertex[g])
-                             ? 0
-                             : side(planes, planes[far], vertex[g]);
-          if (sd > 0) return std::nullopt;
-          if (sd < 0) continue;
-          if (!seen) through.push_back(far);
           if (group[nb] < 0) {
             group[nb] = g;
             stack.push_back(nb);
