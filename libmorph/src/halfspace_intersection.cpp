@@ -874,6 +874,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   parallel_chunks(static_cast<int>(others.size()), 64, [&](int begin, int end) {
     RoundingGuard guard;
     int u = 0;
+    std::vector<int> plateau;  // scratch: each list is then allocated once, at its size
     for (int j = begin; j < end && ok; ++j) {
       const Plane& p = planes[others[j]];
       LazyPrecisePlane precise_p(p);
@@ -892,8 +893,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       const int sd = known_through(known, others[j], vertex[u]) ? 0 : side_of(p, precise_p, u);
       if (sd > 0) ok = false;
       if (sd != 0) continue;
-      std::vector<int>& plateau = touched[j];
-      plateau.push_back(u);
+      plateau.assign(1, u);
       for (std::size_t q = 0; q < plateau.size(); ++q)
         for (int a = adj_begin[plateau[q]]; a < adj_begin[plateau[q] + 1]; ++a)
           if (std::find(plateau.begin(), plateau.end(), adj[a]) == plateau.end() &&
@@ -901,6 +901,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
                side_of(p, precise_p, adj[a]) == 0))
             plateau.push_back(adj[a]);
       std::sort(plateau.begin(), plateau.end());
+      touched[j].assign(plateau.begin(), plateau.end());
     }
   });
   if (!ok) return std::nullopt;
