@@ -714,15 +714,12 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   });
   if (!ok) return std::nullopt;
   std::vector<int> group(nt, -1), seed;
-  std::vector<HVertex> vertex;
-  vertex.reserve(nt);
   {
     std::vector<int> stack;
     for (int t0 = 0; t0 < nt; ++t0) {
       if (group[t0] >= 0) continue;
       const int g = static_cast<int>(seed.size());
       seed.push_back(t0);
-      vertex.push_back(std::move(s.vertex[t0]));
       group[t0] = g;
       stack.assign(1, t0);
       while (!stack.empty()) {
@@ -741,7 +738,14 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       }
     }
   }
-  const int nv = static_cast<int>(vertex.size());
+  const int nv = static_cast<int>(seed.size());
+  // Each group's vertex is its seed's, moved in place to index g (seed[g] >= g, and seeds
+  // increase: a source is never an earlier destination); none moves when every group is a
+  // single triangle.
+  for (int g = 0; g < nv; ++g)
+    if (seed[g] != g) s.vertex[g] = std::move(s.vertex[seed[g]]);
+  s.vertex.resize(nv);
+  std::vector<HVertex> vertex = std::move(s.vertex);
   // The vertex graph (edges between groups): each vertex's neighbours in increasing order,
   // once (a counting pass by vertex, then each short list sorted).
   std::vector<int> adj_begin(nv + 1, 0), adj;
