@@ -1533,15 +1533,18 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const KnownPoints
       }
   }
   s.across.resize(nt);
-  for (int t = 0; t < nt; ++t)
-    for (int k = 0; k < 3; ++k) {
-      const int a = s.corner[t][k], b = s.corner[t][next_corner(k)];
-      int back = -1, found = 0;
-      for (int j = out_begin[b]; j < out_begin[b + 1]; ++j)
-        if (out_head[j] == a) back = out_edge[j], ++found;
-      if (found != 1) return {};  // an open surface, or an edge used twice
-      s.across[t][k] = back / 3;
-    }
+  parallel_chunks(nt, 1024, [&](int begin, int end) {
+    for (int t = begin; t < end && ok; ++t)
+      for (int k = 0; k < 3; ++k) {
+        const int a = s.corner[t][k], b = s.corner[t][next_corner(k)];
+        int back = -1, found = 0;
+        for (int j = out_begin[b]; j < out_begin[b + 1]; ++j)
+          if (out_head[j] == a) back = out_edge[j], ++found;
+        if (found != 1) ok = false;  // an open surface, or an edge used twice
+        s.across[t][k] = back / 3;
+      }
+  });
+  if (!ok) return {};
   return s;
 }
 
