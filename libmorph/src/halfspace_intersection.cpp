@@ -684,20 +684,16 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   // is tested at the triangle's own vertex, in parallel: a triangle that joins a group has
   // its three planes through the group's point (two shared with a member, the far one
   // tested there), with independent normals (det > 0 above), so its vertex is that point
-  // and the signs are the group's.
-  if (s.has_vertex.empty()) {
-    s.vertex.resize(nt);
-    s.has_vertex.assign(nt, 0);
-  }
+  // and the signs are the group's. A surface without vertices gets none stored (large,
+  // and most would be dropped): each is made for its tests, and the seeds' again below.
+  const bool stored = !s.vertex.empty();
   std::vector<signed char> far_side(3 * static_cast<std::size_t>(nt));
   parallel_chunks(nt, 256, [&](int begin, int end) {
     RoundingGuard guard;
+    HVertex local;
     for (int t = begin; t < end && ok; ++t) {
-      HVertex& v = s.vertex[t];
-      if (!s.has_vertex[t]) {
-        v = vertex_of(planes, s.corner[t], known);
-        s.has_vertex[t] = 1;
-      }
+      HVertex& v = stored ? s.vertex[t] : local;
+      if (!stored || !s.has_vertex[t]) v = vertex_of(planes, s.corner[t], known);
       for (int k = 0; k < 3; ++k) {
         const auto& cn = s.corner[s.across[t][k]];
         const int a = s.corner[t][k], b = s.corner[t][(k + 1) % 3];
@@ -742,10 +738,19 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   // Each group's vertex is its seed's, moved in place to index g (seed[g] >= g, and seeds
   // increase: a source is never an earlier destination); none moves when every group is a
   // single triangle.
-  for (int g = 0; g < nv; ++g)
-    if (seed[g] != g) s.vertex[g] = std::move(s.vertex[seed[g]]);
-  s.vertex.resize(nv);
-  std::vector<HVertex> vertex = std::move(s.vertex);
+  std::vector<HVertex> vertex;
+  if (stored) {
+    for (int g = 0; g < nv; ++g)
+      if (seed[g] != g) s.vertex[g] = std::move(s.vertex[seed[g]]);
+    s.vertex.resize(nv);
+    vertex = std::move(s.vertex);
+  } else {
+    vertex.resize(nv);
+    parallel_chunks(nv, 256, [&](int begin, int end) {
+      RoundingGuard guard;
+      for (int g = begin; g < end; ++g) vertex[g] = vertex_of(planes, s.corner[seed[g]], known);
+    });
+  }
   // The vertex graph (edges between groups): each vertex's neighbours in increasing order,
   // once (a counting pass by vertex, then each short list sorted).
   std::vector<int> adj_begin(nv + 1, 0), adj;
@@ -1500,8 +1505,10 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const KnownPoints
   }
   const int nt = first[nv];
   s.corner.resize(nt);
-  s.vertex.resize(nt);
-  s.has_vertex.assign(nt, 0);
+  if (expected.split) {  // otherwise no polygon splits, and none has vertices to keep
+    s.vertex.resize(nt);
+    s.has_vertex.assign(nt, 0);
+  }
   std::atomic<bool> ok = true;
   parallel_chunks(nv, 64, [&](int begin, int end) {
     RoundingGuard guard;
@@ -1509,8 +1516,8 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const KnownPoints
     for (int v = begin; v < end && ok; ++v)
       if (!triangulate_polygon(planes, known, &expected.facets[expected.begin[v]],
                                expected.begin[v + 1] - expected.begin[v], expected.split,
-                               &s.corner[first[v]], &s.vertex[first[v]], &s.has_vertex[first[v]],
-                               scratch))
+                               &s.corner[first[v]], expected.split ? &s.vertex[first[v]] : nullptr,
+                               expected.split ? &s.has_vertex[first[v]] : nullptr, scratch))
         ok = false;
   });
   if (!ok) return {};
