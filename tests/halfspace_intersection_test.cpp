@@ -671,6 +671,41 @@ TEST_CASE("halfspace_intersection: the precise stage rounds vertices as the exac
   CHECK(!probe_precise_point({ExactN(1), ExactN(1), ExactN(1)}, huge).decided[0]);
 }
 
+// Next to a power of two the gap to the neighbour towards zero is half the gap away from
+// it (the rounding steps to both neighbours by the bits of r): points on and just off the
+// midpoints on either side, of either sign, and just off the power itself, decided only as
+// the exact rounding, exact midpoints never.
+TEST_CASE("halfspace_intersection: the precise stage rounds next to powers of two exactly") {
+  int decided = 0;
+  for (int e : {0, 1, -1, 52, 200, -200}) {
+    for (double sign : {1.0, -1.0}) {
+      const double x = sign * std::ldexp(1.0, e), m = std::abs(x);
+      const double away = std::nextafter(m, HUGE_VAL) - m, toward = m - std::nextafter(m, 0.0);
+      for (double gap : {away, -toward}) {
+        for (int k : {1, 3, 20, 40, 70}) {  // 1: the midpoint itself
+          const double off = std::ldexp(gap, -k);
+          const ExactN mid = ExactN(x) + ExactN(sign * gap / 2);
+          const std::vector<ExactN> values =
+              k == 1 ? std::vector<ExactN>{mid}
+                     : std::vector<ExactN>{ExactN(x) + ExactN(sign * off),  // near x itself
+                                           mid + ExactN(sign * off), mid - ExactN(sign * off)};
+          for (const ExactN& v : values) {
+            for (double w : {1.0, 3.0, 0x1p-300}) {
+              const ExactN W(w), X = v * W;
+              const PreciseProbe probe = probe_precise_point({X, X, X}, W);
+              if (k == 1) CHECK(!probe.decided[0]);
+              if (!probe.decided[0]) continue;
+              ++decided;
+              CHECK(same_double(probe.rounded.x, rounded_exactly(v)));
+            }
+          }
+        }
+      }
+    }
+  }
+  CHECK(decided > 100);
+}
+
 // The precise stage of side and compare_along: exact zeros (a fourth plane through the
 // vertex, two vertices on one plane parallel to the fourth) stay undecided, and every
 // sign it decides is the exact sign, down to moves of 2^-90 relative.

@@ -143,11 +143,37 @@ bool strictly_inside(const std::vector<Plane>& planes, const V3<double>& o) {
   return inside;
 }
 
+/// A vertex of the intersection in homogeneous coordinates: X / W with W > 0, the meet
+/// of three of the planes. The exact coordinates are computed only where the filters
+/// (intervals, then double-double) cannot decide, or for a polytope chained further.
+struct HVertex {
+  std::array<int, 3> planes;
+  V3<Interval> Xi;
+  Interval Wi;
+  V3<Interval> xi;  // Xi / Wi
+  bool has_exact = false;
+  V3<ExactN> X;
+  ExactN W;
+  int known = -1;  // the known point it is (KnownPoints), if any
+  // X and W times some positive factor in double-double, within ex and ew of the exact
+  // ones times that factor (make_precise); only when `precise`.
+  V3<DD> px{};
+  DD pw{};
+  V3<double> ex{};
+  double ew = 0;
+  bool precise = false;
+  bool doubles = false;  // a known point X / 1 with X exactly doubles: its rounding is X
+};
+
 /// A candidate dual hull: triangles over plane indices, counter-clockwise seen from
 /// outside, and the triangle across each edge (edge k runs from corner k to corner k + 1).
+/// The vertex of a triangle's three planes (vertex_of, in the corners' order) may come
+/// with it, when the candidate's construction computed it already (has_vertex[t]).
 struct DualSurface {
   std::vector<std::array<int, 3>> corner;
   std::vector<std::array<int, 3>> across;
+  std::vector<HVertex> vertex;  // empty, or one per triangle
+  std::vector<char> has_vertex;
 };
 
 /// The triangles of a hull computed by CGAL; empty when it is not a closed triangulated
@@ -173,36 +199,21 @@ DualSurface surface_of(const HullMesh& hull, const IndexOf& index_of) {
   return s;
 }
 
-/// A vertex of the intersection in homogeneous coordinates: X / W with W > 0, the meet
-/// of three of the planes. The exact coordinates are computed only where the filters
-/// (intervals, then double-double) cannot decide, or for a polytope chained further.
-struct HVertex {
-  std::array<int, 3> planes;
-  V3<Interval> Xi;
-  Interval Wi;
-  V3<Interval> xi;  // Xi / Wi
-  bool has_exact = false;
-  V3<ExactN> X;
-  ExactN W;
-  int known = -1;  // the known point it is (KnownPoints), if any
-  // X and W times some positive factor in double-double, within ex and ew of the exact
-  // ones times that factor (make_precise); only when `precise`.
-  V3<DD> px{};
-  DD pw{};
-  V3<double> ex{};
-  double ew = 0;
-  bool precise = false;
-  bool doubles = false;  // a known point X / 1 with X exactly doubles: its rounding is X
-};
+/// The point of three planes (Cramer's rule) from the cross products of their normals,
+/// bc = n_b x n_c, ca = n_c x n_a, ab = n_a x n_b; W = det(n_a, n_b, n_c).
+template <class T>
+void meet_of_crosses(const V3<T>& na, const T& da, const T& db, const T& dc, const V3<T>& bc,
+                     const V3<T>& ca, const V3<T>& ab, V3<T>& X, T& W) {
+  W = dot(na, bc);
+  X = {da * bc.x + db * ca.x + dc * ab.x, da * bc.y + db * ca.y + dc * ab.y,
+       da * bc.z + db * ca.z + dc * ab.z};
+}
 
 /// The point of three planes (Cramer's rule); W = det(n_a, n_b, n_c).
 template <class T>
 void meet(const V3<T>& na, const T& da, const V3<T>& nb, const T& db, const V3<T>& nc, const T& dc,
           V3<T>& X, T& W) {
-  const V3<T> bc = cross(nb, nc), ca = cross(nc, na), ab = cross(na, nb);
-  W = dot(na, bc);
-  X = {da * bc.x + db * ca.x + dc * ab.x, da * bc.y + db * ca.y + dc * ab.y,
-       da * bc.z + db * ca.z + dc * ab.z};
+  meet_of_crosses(na, da, db, dc, cross(nb, nc), cross(nc, na), cross(na, nb), X, W);
 }
 
 /// The interval vertex of three planes (needs a RoundingGuard).
@@ -215,14 +226,12 @@ HVertex vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& ab
   return v;
 }
 
-/// The vertex of three planes, taken from a known point when the three pass through one
-/// (and their normals are independent: the meet is then that point).
-HVertex vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& abc,
-                  const KnownPoints& known) {
-  HVertex v = vertex_of(planes, abc);
-  if (known.empty() || !(v.Wi.inf() > 0)) return v;
-  const int k = known.common(abc[0], abc[1], abc[2]);
-  if (k < 0) return v;
+/// A vertex of three planes taken from a known point when the three pass through one (and
+/// their normals are independent: the meet is then that point).
+void take_known(const KnownPoints& known, HVertex& v) {
+  if (known.empty() || !(v.Wi.inf() > 0)) return;
+  const int k = known.common(v.planes[0], v.planes[1], v.planes[2]);
+  if (k < 0) return;
   v.known = k;
   v.Xi = known.Xi[k];
   v.Wi = known.Wi[k];
@@ -230,6 +239,12 @@ HVertex vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& ab
   v.X = known.X[k];
   v.W = known.W[k];
   v.has_exact = true;
+}
+/// The vertex of three planes, from a known point where there is one (take_known).
+HVertex vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& abc,
+                  const KnownPoints& known) {
+  HVertex v = vertex_of(planes, abc);
+  take_known(known, v);
   return v;
 }
 
@@ -317,10 +332,33 @@ PrecisePlane precise_plane(const Plane& plane) {
 V3<DD> normal_dd(const PrecisePlane& p) { return {p.c[0], p.c[1], p.c[2]}; }
 V3<Magnitude> normal_magnitude(const PrecisePlane& p) { return magnitude(normal_dd(p)); }
 
+/// The precise meet of valid planes a, b, c (round-to-nearest) from their normals' cross
+/// products bc, ca, ab in double-double, each as `cross` evaluates it or that negated (the
+/// same value of the opposite edge, n_b x n_a = -(n_a x n_b): negation is exact, so the
+/// bound below holds alike).
+void precise_meet(const PrecisePlane& a, const PrecisePlane& b, const PrecisePlane& c,
+                  const V3<DD>& bc, const V3<DD>& ca, const V3<DD>& ab, HVertex& v) {
+  meet_of_crosses(normal_dd(a), a.c[3], b.c[3], c.c[3], bc, ca, ab, v.px, v.pw);
+  V3<Magnitude> mx;
+  Magnitude mw;
+  meet(normal_magnitude(a), magnitude(a.c[3]), normal_magnitude(b), magnitude(b.c[3]),
+       normal_magnitude(c), magnitude(c.c[3]), mx, mw);
+  // Degree 3 in the planes' components; underflow in the cross products is multiplied by
+  // at most |d| (no overflow: |n| < 2, |d| <= 2^400).
+  constexpr double factor = (3 * kPlaneRelative + kEvaluation) * 1.01;
+  const double absolute =
+      0x1p-960 * (1 + std::abs(a.c[3].hi) + std::abs(b.c[3].hi) + std::abs(c.c[3].hi));
+  v.ex = {factor * mx.x.v + absolute, factor * mx.y.v + absolute, factor * mx.z.v + absolute};
+  v.ew = factor * mw.v + 0x1p-960;
+  v.precise = true;
+}
+
 /// The precise coordinates of a vertex (round-to-nearest): a known point's from its exact
-/// ones (W in [1, 2)), another's as the meet of its precise planes. Left out when a plane
-/// is not valid or a value out of range.
-void make_precise(const std::vector<PrecisePlane>& planes, HVertex& v) {
+/// ones (W in [1, 2)), another's as the meet of its precise planes (`crosses`: their
+/// normals' cross products bc, ca, ab when the caller has them, as in precise_meet). Left
+/// out when a plane is not valid or a value out of range.
+void make_precise(const std::vector<PrecisePlane>& planes, HVertex& v,
+                  const std::array<V3<DD>, 3>* crosses = nullptr) {
   if (v.known >= 0) {
     const auto is_double = [](const ExactN& x) {
       const double d = x.to_double();
@@ -340,19 +378,12 @@ void make_precise(const std::vector<PrecisePlane>& planes, HVertex& v) {
   }
   const PrecisePlane &a = planes[v.planes[0]], &b = planes[v.planes[1]], &c = planes[v.planes[2]];
   if (!a.valid || !b.valid || !c.valid) return;
-  meet(normal_dd(a), a.c[3], normal_dd(b), b.c[3], normal_dd(c), c.c[3], v.px, v.pw);
-  V3<Magnitude> mx;
-  Magnitude mw;
-  meet(normal_magnitude(a), magnitude(a.c[3]), normal_magnitude(b), magnitude(b.c[3]),
-       normal_magnitude(c), magnitude(c.c[3]), mx, mw);
-  // Degree 3 in the planes' components; underflow in the cross products is multiplied by
-  // at most |d| (no overflow: |n| < 2, |d| <= 2^400).
-  constexpr double factor = (3 * kPlaneRelative + kEvaluation) * 1.01;
-  const double absolute =
-      0x1p-960 * (1 + std::abs(a.c[3].hi) + std::abs(b.c[3].hi) + std::abs(c.c[3].hi));
-  v.ex = {factor * mx.x.v + absolute, factor * mx.y.v + absolute, factor * mx.z.v + absolute};
-  v.ew = factor * mw.v + 0x1p-960;
-  v.precise = true;
+  if (crosses) {
+    precise_meet(a, b, c, (*crosses)[0], (*crosses)[1], (*crosses)[2], v);
+    return;
+  }
+  const V3<DD> na = normal_dd(a), nb = normal_dd(b), nc = normal_dd(c);
+  precise_meet(a, b, c, cross(nb, nc), cross(nc, na), cross(na, nb), v);
 }
 
 /// Sign of <n, X> - d W from the precise stage, or 2 (round-to-nearest; both precise).
@@ -647,13 +678,33 @@ ExactPoints polytope_points(const std::vector<Plane>& planes, std::vector<HVerte
   return exact;
 }
 
+/// Sorts each list list[begin[i] .. begin[i + 1]) and drops repeats in it, compacting (the
+/// lists are short: an insertion sort).
+void sort_unique_lists(std::vector<int>& begin, std::vector<int>& list) {
+  int kept = 0;
+  for (std::size_t i = 0; i + 1 < begin.size(); ++i) {
+    const int first = begin[i], last = begin[i + 1];
+    for (int j = first + 1; j < last; ++j) {
+      const int x = list[j];
+      int m = j;
+      for (; m > first && list[m - 1] > x; --m) list[m] = list[m - 1];
+      list[m] = x;
+    }
+    begin[i] = kept;
+    for (int j = first; j < last; ++j)
+      if (j == first || list[j] != list[j - 1]) list[kept++] = list[j];
+  }
+  begin.back() = kept;
+  list.resize(kept);
+}
+
 /// Builds the intersection from a candidate dual hull, checking exactly that it is the
 /// dual hull of all the planes; nullopt when it is not. The result has `rounded`, and
 /// `polytope` when `with_polytope` (its exact points computed up front when `eager_exact`,
 /// else on demand: polytope_points).
 std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
                                             const std::vector<Plane>& planes,
-                                            const KnownPoints& known, const DualSurface& s,
+                                            const KnownPoints& known, DualSurface s,
                                             bool with_polytope, bool eager_exact) {
   const int nt = static_cast<int>(s.corner.size());
   const int n = static_cast<int>(planes.size());
@@ -696,40 +747,50 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   }
   // Group triangles whose planes meet in one point (exactly coplanar dual triangles):
   // each group is a vertex of the intersection. Every edge between groups must be
-  // strictly convex: the far plane of each neighbour is strictly satisfied. The planes
-  // found through the group's vertex are kept, so each is tested once (exactly, when
-  // the vertex is degenerate: the filter cannot show a zero).
-  std::vector<int> group(nt, -1), seed;
-  std::vector<HVertex> vertex;
-  {
+  // strictly convex: the far plane of each neighbour is strictly satisfied. Each far plane
+  // is tested at the triangle's own vertex, in parallel: a triangle that joins a group has
+  // its three planes through the group's point (two shared with a member, the far one
+  // tested there), with independent normals (det > 0 above), so its vertex is that point
+  // and the signs are the group's. A surface without vertices gets none stored (large,
+  // and most would be dropped): each is made for its tests, and the seeds' again below.
+  const bool stored = !s.vertex.empty();
+  std::vector<signed char> far_side(3 * static_cast<std::size_t>(nt));
+  parallel_chunks(nt, 256, [&](int begin, int end) {
     RoundingGuard guard;
-    std::vector<int> stack, through;
+    HVertex local;
+    for (int t = begin; t < end && ok; ++t) {
+      HVertex& v = stored ? s.vertex[t] : local;
+      if (!stored || !s.has_vertex[t]) v = vertex_of(planes, s.corner[t], known);
+      for (int k = 0; k < 3; ++k) {
+        const auto& cn = s.corner[s.across[t][k]];
+        const int a = s.corner[t][k], b = s.corner[t][(k + 1) % 3];
+        int far = -1;
+        for (int j = 0; j < 3; ++j)
+          if (cn[j] != a && cn[j] != b) far = cn[j];
+        const int sd = far < 0                        ? 1
+                       : known_through(known, far, v) ? 0
+                                                      : side(planes, planes[far], v);
+        if (sd > 0) ok = false;
+        far_side[3 * t + k] = static_cast<signed char>(sd);
+      }
+    }
+  });
+  if (!ok) return std::nullopt;
+  std::vector<int> group(nt, -1), seed;
+  {
+    std::vector<int> stack;
     for (int t0 = 0; t0 < nt; ++t0) {
       if (group[t0] >= 0) continue;
       const int g = static_cast<int>(seed.size());
       seed.push_back(t0);
-      vertex.push_back(vertex_of(planes, s.corner[t0], known));
-      through.assign(s.corner[t0].begin(), s.corner[t0].end());
       group[t0] = g;
       stack.assign(1, t0);
       while (!stack.empty()) {
         const int t = stack.back();
         stack.pop_back();
         for (int k = 0; k < 3; ++k) {
+          if (far_side[3 * t + k] < 0) continue;
           const int nb = s.across[t][k];
-          const auto& cn = s.corner[nb];
-          const int a = s.corner[t][k], b = s.corner[t][(k + 1) % 3];
-          int far = -1;
-          for (int j = 0; j < 3; ++j)
-            if (cn[j] != a && cn[j] != b) far = cn[j];
-          if (far < 0) return std::nullopt;
-          const bool seen = std::find(through.begin(), through.end(), far) != through.end();
-          const int sd = seen || known_through(known, far, vertex[g])
-                             ? 0
-                             : side(planes, planes[far], vertex[g]);
-          if (sd > 0) return std::nullopt;
-          if (sd < 0) continue;
-          if (!seen) through.push_back(far);
           if (group[nb] < 0) {
             group[nb] = g;
             stack.push_back(nb);
@@ -740,45 +801,69 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       }
     }
   }
-  const int nv = static_cast<int>(vertex.size());
-  // The vertex graph (edges between groups).
+  const int nv = static_cast<int>(seed.size());
+  // Each group's vertex is its seed's, moved in place to index g (seed[g] >= g, and seeds
+  // increase: a source is never an earlier destination); none moves when every group is a
+  // single triangle.
+  std::vector<HVertex> vertex;
+  if (stored) {
+    for (int g = 0; g < nv; ++g)
+      if (seed[g] != g) s.vertex[g] = std::move(s.vertex[seed[g]]);
+    s.vertex.resize(nv);
+    vertex = std::move(s.vertex);
+  } else {
+    vertex.resize(nv);
+    parallel_chunks(nv, 256, [&](int begin, int end) {
+      RoundingGuard guard;
+      for (int g = begin; g < end; ++g) vertex[g] = vertex_of(planes, s.corner[seed[g]], known);
+    });
+  }
+  // The vertex graph (edges between groups): each vertex's neighbours in increasing order,
+  // once (a counting pass by vertex, then each short list sorted).
   std::vector<int> adj_begin(nv + 1, 0), adj;
   {
-    std::vector<std::pair<int, int>> links;
     for (int t = 0; t < nt; ++t)
       for (int k = 0; k < 3; ++k)
-        if (group[s.across[t][k]] != group[t]) links.emplace_back(group[t], group[s.across[t][k]]);
-    std::sort(links.begin(), links.end());
-    links.erase(std::unique(links.begin(), links.end()), links.end());
-    for (const auto& l : links) ++adj_begin[l.first + 1];
-    for (int v = 0; v < nv; ++v) adj_begin[v + 1] += adj_begin[v];
-    for (const auto& l : links) adj.push_back(l.second);
+        if (group[s.across[t][k]] != group[t]) ++adj_begin[group[t] + 1];
+    std::partial_sum(adj_begin.begin(), adj_begin.end(), adj_begin.begin());
+    adj.resize(adj_begin[nv]);
+    std::vector<int> next(adj_begin.begin(), adj_begin.end() - 1);
+    for (int t = 0; t < nt; ++t)
+      for (int k = 0; k < 3; ++k)
+        if (group[s.across[t][k]] != group[t]) adj[next[group[t]]++] = group[s.across[t][k]];
+    sort_unique_lists(adj_begin, adj);
   }
   // Facets: dual vertices with at least three groups around them (others lie on a dual
   // edge or facet: their planes only touch the intersection).
   std::vector<int> some_triangle(n, -1);
   for (int t = 0; t < nt; ++t)
     for (int k = 0; k < 3; ++k) some_triangle[s.corner[t][k]] = t;
-  std::vector<std::vector<int>> faces;
-  std::vector<int> face_halfspace;
+  // Facet f's cycle of vertices is face_vertex[face_begin[f] .. face_begin[f + 1]).
+  std::vector<int> face_begin(1, 0), face_vertex, face_halfspace;
+  face_vertex.reserve(3 * static_cast<std::size_t>(nt));
   for (int p = 0; p < n; ++p) {
     if (some_triangle[p] < 0) continue;
-    std::vector<int> cyc;
+    const std::size_t start = face_vertex.size();
     int t = some_triangle[p], steps = 0;
     do {
       const int g = group[t];
-      if (cyc.empty() || cyc.back() != g) cyc.push_back(g);
+      if (face_vertex.size() == start || face_vertex.back() != g) face_vertex.push_back(g);
       int k = 0;
       while (k < 3 && s.corner[t][k] != p) ++k;
       if (k == 3 || ++steps > nt) return std::nullopt;
       t = s.across[t][k];
     } while (t != some_triangle[p]);
-    while (cyc.size() > 1 && cyc.front() == cyc.back()) cyc.pop_back();
-    if (cyc.size() < 3) continue;
-    faces.push_back(std::move(cyc));
+    while (face_vertex.size() > start + 1 && face_vertex[start] == face_vertex.back())
+      face_vertex.pop_back();
+    if (face_vertex.size() < start + 3) {
+      face_vertex.resize(start);
+      continue;
+    }
+    face_begin.push_back(static_cast<int>(face_vertex.size()));
     face_halfspace.push_back(p);
   }
-  if (faces.size() < 4) return std::nullopt;
+  const int nf = static_cast<int>(face_halfspace.size());
+  if (nf < 4) return std::nullopt;
   // Precise vertices, for the checks below (a second filter stage) and the rounding; exact
   // ones only where those cannot decide (LazyExact; for a polytope computed with further,
   // see polytope_points).
@@ -795,9 +880,59 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
         if (used[i]) precise[i] = precise_plane(planes[i]);
     });
   }
+  // The cross products of precise normals along the edges of the triangles that give the
+  // vertices (`seed`, when made from valid planes): an edge between two such triangles is
+  // computed once, by the smaller one, and taken negated by the other.
+  std::vector<char> from_planes(nt, 0);
+  for (int v = 0; v < nv; ++v) {
+    const HVertex& x = vertex[v];
+    from_planes[seed[v]] = x.known < 0 && x.planes == s.corner[seed[v]] &&
+                           precise[x.planes[0]].valid && precise[x.planes[1]].valid &&
+                           precise[x.planes[2]].valid;
+  }
+  std::vector<V3<DD>> edge_cross(3 * static_cast<std::size_t>(nt));
+  const auto shared = [&](int t, int k) {
+    const int u = s.across[t][k];
+    return from_planes[u] && u < t;
+  };
   parallel_chunks(nv, 128, [&](int begin, int end) {
     CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
-    for (int v = begin; v < end; ++v) make_precise(precise, vertex[v]);
+    for (int v = begin; v < end; ++v) {
+      const int t = seed[v];
+      if (!from_planes[t]) continue;
+      for (int k = 0; k < 3; ++k)
+        if (!shared(t, k))
+          edge_cross[3 * t + k] = cross(normal_dd(precise[s.corner[t][k]]),
+                                        normal_dd(precise[s.corner[t][k == 2 ? 0 : k + 1]]));
+    }
+  });
+  parallel_chunks(nv, 128, [&](int begin, int end) {
+    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    for (int v = begin; v < end; ++v) {
+      const int t = seed[v];
+      if (!from_planes[t]) {
+        make_precise(precise, vertex[v]);
+      } else {
+        // Edge k runs from corner k to corner k + 1: ab, bc, ca for k = 0, 1, 2.
+        std::array<V3<DD>, 3> along;
+        for (int k = 0; k < 3; ++k) {
+          along[k] = edge_cross[3 * t + k];
+          if (!shared(t, k)) continue;
+          const int u = s.across[t][k], a = s.corner[t][k], b = s.corner[t][k == 2 ? 0 : k + 1];
+          int j = 0;
+          while (j < 3 && s.corner[u][j == 2 ? 0 : j + 1] != a) ++j;
+          // u's edge j is b -> a, across from t (an oriented surface), so u computed it.
+          if (j < 3 && s.corner[u][j] == b && s.across[u][j] == t) {
+            const V3<DD>& c = edge_cross[3 * u + j];
+            along[k] = {-c.x, -c.y, -c.z};
+          } else {
+            along[k] = cross(normal_dd(precise[a]), normal_dd(precise[b]));
+          }
+        }
+        const std::array<V3<DD>, 3> crosses{along[1], along[2], along[0]};
+        make_precise(precise, vertex[v], &crosses);
+      }
+    }
   });
   LazyExact exact_vertex(planes, vertex);
   const auto side_of = [&](const Plane& p, LazyPrecisePlane& q, int v) {
@@ -814,6 +949,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   parallel_chunks(static_cast<int>(others.size()), 64, [&](int begin, int end) {
     RoundingGuard guard;
     int u = 0;
+    std::vector<int> plateau;  // scratch: each list is then allocated once, at its size
     for (int j = begin; j < end && ok; ++j) {
       const Plane& p = planes[others[j]];
       LazyPrecisePlane precise_p(p);
@@ -832,8 +968,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       const int sd = known_through(known, others[j], vertex[u]) ? 0 : side_of(p, precise_p, u);
       if (sd > 0) ok = false;
       if (sd != 0) continue;
-      std::vector<int>& plateau = touched[j];
-      plateau.push_back(u);
+      plateau.assign(1, u);
       for (std::size_t q = 0; q < plateau.size(); ++q)
         for (int a = adj_begin[plateau[q]]; a < adj_begin[plateau[q] + 1]; ++a)
           if (std::find(plateau.begin(), plateau.end(), adj[a]) == plateau.end() &&
@@ -841,56 +976,89 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
                side_of(p, precise_p, adj[a]) == 0))
             plateau.push_back(adj[a]);
       std::sort(plateau.begin(), plateau.end());
+      touched[j].assign(plateau.begin(), plateau.end());
     }
   });
   if (!ok) return std::nullopt;
-  // Verified. The half-spaces through each vertex: those of its triangles and the
-  // touching ones. A touching plane along a whole facet is that facet's plane given twice:
-  // the facet takes the smaller index.
-  std::vector<std::vector<int>> key(nv);
-  for (int t = 0; t < nt; ++t)
-    key[group[t]].insert(key[group[t]].end(), s.corner[t].begin(), s.corner[t].end());
+  // Verified. The half-spaces through each vertex (key[key_begin[v] ..), sorted, once):
+  // those of its triangles and the touching ones. A touching plane along a whole facet is
+  // that facet's plane given twice: the facet takes the smaller index.
+  std::vector<int> key_begin(nv + 1, 0), key;
+  for (int t = 0; t < nt; ++t) key_begin[group[t] + 1] += 3;
+  for (const auto& plateau : touched)
+    for (int v : plateau) ++key_begin[v + 1];
+  std::partial_sum(key_begin.begin(), key_begin.end(), key_begin.begin());
+  key.resize(key_begin[nv]);
+  {
+    std::vector<int> next(key_begin.begin(), key_begin.end() - 1);
+    for (int t = 0; t < nt; ++t)
+      for (int a : s.corner[t]) key[next[group[t]]++] = a;
+    for (std::size_t j = 0; j < others.size(); ++j)
+      for (int v : touched[j]) key[next[v]++] = others[j];
+  }
+  sort_unique_lists(key_begin, key);
   for (std::size_t j = 0; j < others.size(); ++j) {
-    for (int v : touched[j]) key[v].push_back(others[j]);
     if (touched[j].size() < 3) continue;
-    for (std::size_t f = 0; f < faces.size(); ++f) {
-      std::vector<int> cyc = faces[f];
+    for (int f = 0; f < nf; ++f) {
+      if (face_begin[f + 1] - face_begin[f] != static_cast<int>(touched[j].size())) continue;
+      std::vector<int> cyc(face_vertex.begin() + face_begin[f],
+                           face_vertex.begin() + face_begin[f + 1]);
       std::sort(cyc.begin(), cyc.end());
       if (cyc == touched[j]) face_halfspace[f] = std::min(face_halfspace[f], others[j]);
     }
   }
-  for (auto& k : key) {
-    std::sort(k.begin(), k.end());
-    k.erase(std::unique(k.begin(), k.end()), k.end());
-  }
   // Number vertices and facets canonically (hull orders depend on CGAL's internal
   // shuffling): a vertex by the sorted half-spaces through it, a facet by its half-space,
   // each cycle starting at its smallest vertex. The output then depends only on the input.
+  // Both orders are strict (no two vertices have the same half-spaces, no two facets the
+  // same one), so bucket passes give them: vertices by their smallest half-space, each
+  // bucket (a few vertices) then sorted by the whole list.
   std::vector<int> order(nv), rank(nv);
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](int a, int b) { return key[a] < key[b]; });
-  for (int r = 0; r < nv; ++r) rank[order[r]] = r;
-  std::vector<int> forder(faces.size());
-  std::iota(forder.begin(), forder.end(), 0);
-  std::sort(forder.begin(), forder.end(),
-            [&](int a, int b) { return face_halfspace[a] < face_halfspace[b]; });
-  std::vector<std::vector<int>> sorted_faces;
-  std::vector<int> sorted_halfspace;
-  for (int f : forder) {
-    auto cyc = faces[f];
-    for (int& g : cyc) g = rank[g];
-    std::rotate(cyc.begin(), std::min_element(cyc.begin(), cyc.end()), cyc.end());
-    sorted_faces.push_back(std::move(cyc));
-    sorted_halfspace.push_back(face_halfspace[f]);
+  {
+    std::vector<int> bucket(n + 1, 0);
+    for (int v = 0; v < nv; ++v) ++bucket[key[key_begin[v]] + 1];
+    std::partial_sum(bucket.begin(), bucket.end(), bucket.begin());
+    std::vector<int> next(bucket.begin(), bucket.end() - 1);
+    for (int v = 0; v < nv; ++v) order[next[key[key_begin[v]]]++] = v;
+    const auto key_less = [&](int a, int b) {
+      return std::lexicographical_compare(
+          key.begin() + key_begin[a], key.begin() + key_begin[a + 1], key.begin() + key_begin[b],
+          key.begin() + key_begin[b + 1]);
+    };
+    for (int p = 0; p < n; ++p)
+      if (bucket[p + 1] - bucket[p] > 1)
+        std::sort(order.begin() + bucket[p], order.begin() + bucket[p + 1], key_less);
   }
-  faces = std::move(sorted_faces);
-  face_halfspace = std::move(sorted_halfspace);
+  for (int r = 0; r < nv; ++r) rank[order[r]] = r;
+  {
+    std::vector<int> facet_of(n, -1);  // by half-space
+    for (int f = 0; f < nf; ++f) facet_of[face_halfspace[f]] = f;
+    std::vector<int> sorted_begin(1, 0), sorted_vertex, sorted_halfspace;
+    sorted_vertex.reserve(face_vertex.size());
+    sorted_halfspace.reserve(nf);
+    for (int p = 0; p < n; ++p) {
+      const int f = facet_of[p];
+      if (f < 0) continue;
+      const auto first = sorted_vertex.end() - sorted_vertex.begin();
+      for (int j = face_begin[f]; j < face_begin[f + 1]; ++j)
+        sorted_vertex.push_back(rank[face_vertex[j]]);
+      std::rotate(sorted_vertex.begin() + first,
+                  std::min_element(sorted_vertex.begin() + first, sorted_vertex.end()),
+                  sorted_vertex.end());
+      sorted_begin.push_back(static_cast<int>(sorted_vertex.size()));
+      sorted_halfspace.push_back(p);
+    }
+    face_begin = std::move(sorted_begin);
+    face_vertex = std::move(sorted_vertex);
+    face_halfspace = std::move(sorted_halfspace);
+  }
   // Circulating around a dual vertex may run clockwise: orient by the first facet.
   {
-    std::vector<int> cyc = faces[0];
+    std::vector<int> cyc(face_vertex.begin(), face_vertex.begin() + face_begin[1]);
     for (int& r : cyc) r = order[r];
     if (clockwise(cyc, vertex, hs[face_halfspace[0]].normal, exact_vertex))
-      for (auto& c : faces) std::reverse(c.begin(), c.end());
+      for (int f = 0; f < nf; ++f)
+        std::reverse(face_vertex.begin() + face_begin[f], face_vertex.begin() + face_begin[f + 1]);
   }
   // Rounded vertices, exactly rounded from the homogeneous coordinates: from the precise
   // ones unless they lie too close to a rounding midpoint, from the exact ones then.
@@ -919,13 +1087,19 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       rp.points[r] = {rounded[0], rounded[1], rounded[2]};
     }
   });
-  rp.face_begin.assign(1, 0);
-  for (std::size_t f = 0; f < faces.size(); ++f) {
-    rp.corner_vertex.insert(rp.corner_vertex.end(), faces[f].begin(), faces[f].end());
-    rp.face_begin.push_back(static_cast<int>(rp.corner_vertex.size()));
-    rp.face_source.push_back(hs[face_halfspace[f]].source);
-    rp.face_element.push_back(hs[face_halfspace[f]].element);
+  rp.face_source.resize(nf);
+  rp.face_element.resize(nf);
+  for (int f = 0; f < nf; ++f) {
+    rp.face_source[f] = hs[face_halfspace[f]].source;
+    rp.face_element[f] = hs[face_halfspace[f]].element;
   }
+  std::vector<std::vector<int>> faces;  // for a polytope
+  if (with_polytope)
+    for (int f = 0; f < nf; ++f)
+      faces.emplace_back(face_vertex.begin() + face_begin[f],
+                         face_vertex.begin() + face_begin[f + 1]);
+  rp.face_begin = std::move(face_begin);
+  rp.corner_vertex = std::move(face_vertex);
   if (with_polytope) {
     std::vector<V3<ExactN>> normals(faces.size());
     for (std::size_t f = 0; f < faces.size(); ++f) normals[f] = hs[face_halfspace[f]].normal;
@@ -1257,9 +1431,10 @@ int common_point(const KnownPoints& known, const int* p, int k) {
 /// Scratch space of triangulate_polygon, kept across the polygons of a chunk.
 struct PolygonScratch {
   std::vector<std::array<int, 3>> triangle;  // corners: positions in the polygon
-  std::vector<HVertex> vertex;               // each triangle's vertex, once tested
-  std::vector<char> ready;                   // whether it is computed
+  std::vector<char> ready;                   // whether its vertex is computed
   std::vector<std::pair<int, int>> pending;  // diagonals to test
+  std::vector<V3<Interval>> cross;           // n_i x n_j of positions i, j (k i + j)
+  std::vector<char> has_cross;
 };
 
 /// Flips per corner after which a polygon's triangulation gives up: Lawson's flips may
@@ -1276,9 +1451,12 @@ constexpr int kFlipsPerCorner = 4;
 /// triangle is not positively oriented, the flips take more than kFlipsPerCorner k (the
 /// guess is then likely wrong, and the hull is computed; a triangle never tested is left to
 /// the check), or the polygon would split and `split` is false (ExpectedVertices::split).
+/// When it splits the polygon, each final triangle's vertex is in out_vertex (out_has set;
+/// it is the flips' scratch space on the way).
 /// Needs a RoundingGuard.
 bool triangulate_polygon(const std::vector<Plane>& planes, const KnownPoints& known, const int* p,
-                         int k, bool split, std::array<int, 3>* out, PolygonScratch& scratch) {
+                         int k, bool split, std::array<int, 3>* out, HVertex* out_vertex,
+                         char* out_has, PolygonScratch& scratch) {
   // Planes through one known point (facets of A moved by one vertex of B): one vertex.
   if (k == 3 || common_point(known, p, k) >= 0) {
     for (int i = 1; i + 1 < k; ++i) out[i - 1] = {p[0], p[i], p[i + 1]};
@@ -1286,7 +1464,7 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const KnownPoints& kn
   }
   if (!split) return false;
   auto& triangle = scratch.triangle;
-  auto& vertex = scratch.vertex;
+  HVertex* vertex = out_vertex;  // each triangle's vertex, computed where it is ready
   auto& ready = scratch.ready;
   auto& pending = scratch.pending;
   triangle.clear();
@@ -1295,15 +1473,43 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const KnownPoints& kn
     triangle.push_back({0, i, i + 1});
     if (i > 1) pending.emplace_back(0, i);
   }
-  vertex.resize(triangle.size());
   ready.assign(triangle.size(), 0);
+  scratch.cross.resize(static_cast<std::size_t>(k) * k);
+  scratch.has_cross.assign(static_cast<std::size_t>(k) * k, 0);
+  // The cross product of the interval normals of positions i and j, computed once for
+  // both orders (n_j x n_i is its exact negation: the same intervals as computed afresh).
+  const auto cross_of = [&](int i, int j) -> const V3<Interval>& {
+    V3<Interval>& c = scratch.cross[i * k + j];
+    if (scratch.has_cross[i * k + j]) return c;
+    if (scratch.has_cross[j * k + i]) {
+      const V3<Interval>& r = scratch.cross[j * k + i];
+      c = {-r.x, -r.y, -r.z};
+    } else {
+      c = cross(planes[p[i]].ni, planes[p[j]].ni);
+    }
+    scratch.has_cross[i * k + j] = 1;
+    return c;
+  };
+  // Triangle t's vertex, as vertex_of(planes, abc, known) computes it.
+  const auto compute_vertex = [&](int t) {
+    ready[t] = 1;
+    const auto [i, j, l] = triangle[t];
+    HVertex& v = vertex[t];  // fresh, or a flipped triangle's: drop what that one had
+    v.has_exact = false;
+    v.known = -1;
+    v.planes = {p[i], p[j], p[l]};
+    const Plane &a = planes[p[i]], &b = planes[p[j]], &c = planes[p[l]];
+    meet_of_crosses(a.ni, a.di, b.di, c.di, cross_of(j, l), cross_of(l, i), cross_of(i, j), v.Xi,
+                    v.Wi);
+    v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
+    take_known(known, v);
+  };
   // Triangle t's vertex (computed when first tested); false when t is not positively
   // oriented.
   const auto make_vertex = [&](int t) {
     if (ready[t]) return true;
-    ready[t] = 1;
-    const std::array<int, 3> abc{p[triangle[t][0]], p[triangle[t][1]], p[triangle[t][2]]};
-    vertex[t] = vertex_of(planes, abc, known);
+    compute_vertex(t);
+    const std::array<int, 3>& abc = vertex[t].planes;
     return vertex[t].Wi.inf() > 0 || det_sign(planes[abc[0]], planes[abc[1]], planes[abc[2]]) > 0;
   };
   // The triangle holding the directed edge a -> c and that edge's slot in it, or -1.
@@ -1333,8 +1539,13 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const KnownPoints& kn
     for (const auto& e : {std::pair(a, d), std::pair(d, c), std::pair(c, b), std::pair(b, a)})
       if (diagonal(e.first, e.second)) pending.push_back(e);
   }
-  for (std::size_t t = 0; t < triangle.size(); ++t)
+  // Every final triangle's vertex, for the check (the untested ones cheaply, from the
+  // cross products at hand; their orientation is left to the check).
+  for (std::size_t t = 0; t < triangle.size(); ++t) {
     out[t] = {p[triangle[t][0]], p[triangle[t][1]], p[triangle[t][2]]};
+    if (!ready[t]) compute_vertex(static_cast<int>(t));
+    out_has[t] = 1;
+  }
   return true;
 }
 
@@ -1354,6 +1565,10 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const KnownPoints
   }
   const int nt = first[nv];
   s.corner.resize(nt);
+  if (expected.split) {  // otherwise no polygon splits, and none has vertices to keep
+    s.vertex.resize(nt);
+    s.has_vertex.assign(nt, 0);
+  }
   std::atomic<bool> ok = true;
   parallel_chunks(nv, 64, [&](int begin, int end) {
     RoundingGuard guard;
@@ -1361,7 +1576,8 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const KnownPoints
     for (int v = begin; v < end && ok; ++v)
       if (!triangulate_polygon(planes, known, &expected.facets[expected.begin[v]],
                                expected.begin[v + 1] - expected.begin[v], expected.split,
-                               &s.corner[first[v]], scratch))
+                               &s.corner[first[v]], expected.split ? &s.vertex[first[v]] : nullptr,
+                               expected.split ? &s.has_vertex[first[v]] : nullptr, scratch))
         ok = false;
   });
   if (!ok) return {};
@@ -1384,15 +1600,18 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const KnownPoints
       }
   }
   s.across.resize(nt);
-  for (int t = 0; t < nt; ++t)
-    for (int k = 0; k < 3; ++k) {
-      const int a = s.corner[t][k], b = s.corner[t][next_corner(k)];
-      int back = -1, found = 0;
-      for (int j = out_begin[b]; j < out_begin[b + 1]; ++j)
-        if (out_head[j] == a) back = out_edge[j], ++found;
-      if (found != 1) return {};  // an open surface, or an edge used twice
-      s.across[t][k] = back / 3;
-    }
+  parallel_chunks(nt, 1024, [&](int begin, int end) {
+    for (int t = begin; t < end && ok; ++t)
+      for (int k = 0; k < 3; ++k) {
+        const int a = s.corner[t][k], b = s.corner[t][next_corner(k)];
+        int back = -1, found = 0;
+        for (int j = out_begin[b]; j < out_begin[b + 1]; ++j)
+          if (out_head[j] == a) back = out_edge[j], ++found;
+        if (found != 1) ok = false;  // an open surface, or an edge used twice
+        s.across[t][k] = back / 3;
+      }
+  });
+  if (!ok) return {};
   return s;
 }
 
@@ -1438,8 +1657,8 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
       const auto outcome = IncrementalHull(planes, known, o_double, reach).run(s);
       if (outcome == IncrementalHull::Outcome::too_small) continue;
       if (outcome == IncrementalHull::Outcome::hull) {
-        if (auto built =
-                build_verified(hs, planes, known, s, options.polytope, options.eager_exact)) {
+        if (auto built = build_verified(hs, planes, known, std::move(s), options.polytope,
+                                        options.eager_exact)) {
           built->route = HullRoute::incremental;
           return std::move(*built);
         }
