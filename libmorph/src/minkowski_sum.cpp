@@ -118,10 +118,68 @@ struct WalkScratch {
 /// is inside one (`end`), is not walked on from: the arc enters it once and stays (a convex
 /// region), so its one crossing into it is found from the region before.
 void edge_facets(const Polytope& A, int a, const ArcPlane& plane_a, const Polytope& B,
-                 const std::vector<ArcPlane>& planes_b, const Location& start, const Location& end,
-                 WalkScratch& w, FacetBuffer& out) {
+                 const Location& start, const Location& end, WalkScratch& w, FacetBuffer& out) {
   const auto& ea = A.edges[a];
   const NormalRef n1{&A, ea.left}, n2{&A, ea.right};
+  const int ua = ea.from, wa = ea.to;
+  // The parallelogram of a crossing with edge e of B, whose arc's right facet's normal is on
+  // side `side_of_b` of a's great circle.
+  auto emit = [&](int e, int side_of_b) {
+    const int ub = B.edges[e].from, wb = B.edges[e].to;
+    const std::uint64_t quad[2][4] = {
+        {pair_key(wa, wb), pair_key(wa, ub), pair_key(ua, ub), pair_key(ua, wb)},   // side < 0
+        {pair_key(wa, ub), pair_key(wa, wb), pair_key(ua, wb), pair_key(ua, ub)}};  // side > 0
+    const auto& q = quad[side_of_b > 0];
+    out.corners.insert(out.corners.end(), q, q + 4);
+    out.sizes.push_back(4);
+    out.origins.push_back({FacetKind::edge,
+                           {Element::Kind::edge, A.edge_source[a]},
+                           {Element::Kind::edge, B.edge_source[e]}});
+  };
+  if (start.kind == Location::Kind::vertex && end.kind == Location::Kind::vertex) {
+    // The usual short arcs first, by the double filters alone: when a's arc starts inside
+    // region l and ends inside region r, crossing an arc of l's boundary at a point interior
+    // to both arcs is where it leaves l (a convex region, a segment from its interior leaves
+    // it once) into the region across, and from there likewise. So a crossing of the arc
+    // between l and r, or of the arcs l | w and w | r for a region w next to both, is all
+    // the walk below would find (the same crossings, the same sides). Anything else (not
+    // decided by the filters, longer arcs) takes the walk.
+    auto crosses = [&](int e, int& side_of_b) {
+      const auto& eb = B.edges[e];
+      const int s1 = orient_arc_filter(plane_a, NormalRef{&B, eb.left});
+      const int s2 = orient_arc_filter(plane_a, NormalRef{&B, eb.right});
+      if (s1 == kUndecided || s2 == kUndecided || s1 * s2 >= 0) return false;
+      const ArcPlane plane_b = arc_plane(B, e);
+      const int t1 = orient_arc_filter(plane_b, n1), t2 = orient_arc_filter(plane_b, n2);
+      if (t1 == kUndecided || t2 == kUndecided || t1 * t2 >= 0 || t1 != -s1) return false;
+      side_of_b = s2;  // as arc_contact gives it
+      return true;
+    };
+    auto edge_between = [&](int v, int u) {
+      for (int s = B.fan_begin[v]; s < B.fan_begin[v + 1]; ++s)
+        if (B.fan_vertex[s] == u) return B.fan_edge[s];
+      return -1;
+    };
+    const int l = start.index, r = end.index;
+    int side1, side2;
+    if (const int e = edge_between(l, r); e >= 0) {
+      if (crosses(e, side1)) {
+        emit(e, side1);
+        return;
+      }
+    } else {
+      for (int s = B.fan_begin[l]; s < B.fan_begin[l + 1]; ++s) {
+        const int e2 = edge_between(B.fan_vertex[s], r);
+        if (e2 < 0) continue;
+        const int e1 = B.fan_edge[s];
+        if (crosses(e1, side1) && crosses(e2, side2)) {  // in B's edge order
+          emit(std::min(e1, e2), e1 < e2 ? side1 : side2);
+          emit(std::max(e1, e2), e1 < e2 ? side2 : side1);
+          return;
+        }
+      }
+    }
+  }
   const int stamp = a + 1;
   w.queue.clear();
   auto visit = [&](int v) {
@@ -168,10 +226,12 @@ void edge_facets(const Polytope& A, int a, const ArcPlane& plane_a, const Polyto
       w.edge_stamp[e] = stamp;
       const auto& eb = B.edges[e];
       int s1 = side(eb.left), s2 = side(eb.right);
+      if (s1 != kUndecided && s2 != kUndecided && s1 * s2 > 0) continue;  // as below, sooner
+      const ArcPlane plane_b = arc_plane(B, e);
       if (s1 == kUndecided || s2 == kUndecided) {
         // Nearly on a's great circle. Before deciding exactly: a's arc strictly on one side
         // of b's great circle touches nothing.
-        const int u1 = orient_arc_filter(planes_b[e], n1), u2 = orient_arc_filter(planes_b[e], n2);
+        const int u1 = orient_arc_filter(plane_b, n1), u2 = orient_arc_filter(plane_b, n2);
         if (u1 != kUndecided && u2 != kUndecided && u1 * u2 > 0) continue;
         s1 = exact_side(eb.left);
         s2 = exact_side(eb.right);
@@ -179,8 +239,8 @@ void edge_facets(const Polytope& A, int a, const ArcPlane& plane_a, const Polyto
       if (s1 * s2 > 0) continue;  // b's arc strictly on one side of a's great circle
       int t1 = 0, t2 = 0;
       if (arc_contact_needs_t(s1, s2)) {
-        t1 = orient_arc(B, e, planes_b[e], n1);
-        t2 = orient_arc(B, e, planes_b[e], n2);
+        t1 = orient_arc(B, e, plane_b, n1);
+        t2 = orient_arc(B, e, plane_b, n2);
       }
       const ArcContact c =
           arc_contact(n1, n2, NormalRef{&B, eb.left}, NormalRef{&B, eb.right}, s1, s2, t1, t2);
@@ -189,19 +249,7 @@ void edge_facets(const Polytope& A, int a, const ArcPlane& plane_a, const Polyto
     }
   }
   std::sort(crossings.begin(), crossings.end());
-  const int ua = ea.from, wa = ea.to;
-  for (const auto& [e, side_of_b] : crossings) {
-    const int ub = B.edges[e].from, wb = B.edges[e].to;
-    const std::uint64_t quad[2][4] = {
-        {pair_key(wa, wb), pair_key(wa, ub), pair_key(ua, ub), pair_key(ua, wb)},   // side < 0
-        {pair_key(wa, ub), pair_key(wa, wb), pair_key(ua, wb), pair_key(ua, ub)}};  // side > 0
-    const auto& q = quad[side_of_b > 0];
-    out.corners.insert(out.corners.end(), q, q + 4);
-    out.sizes.push_back(4);
-    out.origins.push_back({FacetKind::edge,
-                           {Element::Kind::edge, A.edge_source[a]},
-                           {Element::Kind::edge, B.edge_source[e]}});
-  }
+  for (const auto& [e, side_of_b] : crossings) emit(e, side_of_b);
 }
 
 /// Where to start locating each facet g of B in A's Gauss map, from A's facets located
@@ -247,9 +295,10 @@ SumFacets gather(std::initializer_list<const std::vector<FacetBuffer>*> lists) {
 }  // namespace
 
 SumFacets fims_facets(const Polytope& A, const Polytope& B) {
-  const std::vector<ArcPlane> planes_a = arc_planes(A), planes_b = arc_planes(B);
+  // A's arc planes serve the edge loop (B's are formed as its walks need them).
+  const std::vector<ArcPlane> planes_a = arc_planes(A);
   // The contributing vertices of A's facets; where B's facets sit on A.
-  const std::vector<Location> loc_a = locate_all(A, B, planes_b);
+  const std::vector<Location> loc_a = locate_all(A, B);
   // From here two independent branches (side by side when threads allow, each loop in
   // parallel chunks too): B's facets located in A and the corner facets, and the translated
   // and edge facets, which need only loc_a. Fewer joins than one loop after another, and
@@ -258,7 +307,7 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
   run_both(
       [&] {
         const std::vector<int> hints_b = walk_starts(A, B, loc_a);
-        const std::vector<Location> loc_b = locate_all(B, A, planes_a, &hints_b);
+        const std::vector<Location> loc_b = locate_all(B, A, &hints_b);
         // Corner facets: one per facet of B whose normal is not also a facet normal of A.
         corner = in_chunks(B.num_faces(), [&](int begin, int end, FacetBuffer& out) {
           for (int g = begin; g < end; ++g)
@@ -282,7 +331,7 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
             if (l.kind == Location::Kind::vertex && r.kind == Location::Kind::vertex &&
                 l.index == r.index)
               continue;
-            edge_facets(A, a, planes_a[a], B, planes_b, l, r, w, out);
+            edge_facets(A, a, planes_a[a], B, l, r, w, out);
           }
         });
       });
