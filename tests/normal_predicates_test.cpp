@@ -78,6 +78,13 @@ Mesh sample(const std::string& name) {
   return morph::read_mesh(std::string(MORPH_SAMPLES_DIR) + "/" + name);
 }
 
+/// The mesh moved by (t, 2t, 3t).
+Mesh shifted(Mesh mesh, double t) {
+  for (const auto v : mesh.vertices())
+    mesh.set_point(v, mesh.point(v) + morph::Point(t, 2 * t, 3 * t));
+  return mesh;
+}
+
 }  // namespace
 
 TEST_CASE(
@@ -177,5 +184,55 @@ TEST_CASE("normal predicates: orientation against an arc's plane agrees with exa
     }
     CHECK(tested > 0);
     MESSAGE(tested << " orientations against arcs, " << zero << " exactly zero");
+  }
+}
+
+// locate's region test reads the arc planes per fan slot, oriented as the slot runs
+// (slot_planes): the filter's decisions must be those of exact det(N_fan[s], N_fan[s+1], x),
+// also for the slots that run against their edge, on the nearest normals of a finer sphere,
+// a nearly identical one, and the same far from unit scale (normals do not change).
+TEST_CASE("normal predicates: a region's slot planes agree with exact evaluation") {
+  const Mesh ico1280 = sample("icosphere_1280.off");
+  const std::vector<std::pair<Mesh, Mesh>> pairs = {
+      {sample("icosphere_320.off"), ico1280},
+      {ico1280, morph::test::transformed(ico1280, small_rotation(1e-12))},
+      {morph::test::transformed(ico1280, {0x1p-200, 0, 0, 0, 0x1p-200, 0, 0, 0, 0x1p-200}),
+       morph::test::transformed(sample("icosphere_320.off"),
+                                {0x1p200, 0, 0, 0, 0x1p200, 0, 0, 0, 0x1p200})},
+      {shifted(sample("icosphere_320.off"), 1024), shifted(ico1280, -4096)}};
+  for (const auto& [a, b] : pairs) {
+    const Polytope A = morph::detail::make_operand(a, "A");
+    const Polytope B = morph::detail::make_operand(b, "B");
+    const auto slots = morph::detail::slot_planes(B);
+    REQUIRE(slots.size() == B.fan_face.size());
+    int tested = 0, decided = 0, flipped = 0;
+    std::vector<int> order(A.num_faces());
+    for (int v = 0; v < B.num_vertices(); ++v) {
+      const int begin = B.fan_begin[v], n = B.fan_begin[v + 1] - begin;
+      for (int i = 0; i < n; ++i) {
+        const int s = begin + i;
+        const NormalRef l{&B, B.fan_face[s]}, r{&B, B.fan_face[begin + (i + 1) % n]};
+        flipped += B.edges[B.fan_edge[s]].left != l.face;
+        const auto& m = l.unit();
+        std::iota(order.begin(), order.end(), 0);
+        std::partial_sort(order.begin(), order.begin() + 3, order.end(), [&](int f, int g) {
+          const auto &u = A.unit_normals[f], &w = A.unit_normals[g];
+          return m.x * u.x + m.y * u.y + m.z * u.z > m.x * w.x + m.y * w.y + m.z * w.z;
+        });
+        for (int k = 0; k < 3; ++k) {
+          const NormalRef x{&A, order[k]};
+          const int exact = CGAL::sign(morph::detail::det(l.exact(), r.exact(), x.exact()));
+          const int filter = morph::detail::orient_arc_filter(slots[s], x);
+          if (filter != morph::detail::kUndecided) {
+            CHECK(filter == exact);
+            ++decided;
+          }
+          ++tested;
+        }
+      }
+    }
+    CHECK(flipped > 0);
+    CHECK(decided > 0);
+    MESSAGE(tested << " slot orientations, " << decided << " decided by the filter");
   }
 }

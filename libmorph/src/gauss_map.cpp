@@ -15,39 +15,47 @@ bool between(const NormalRef& p, const NormalRef& x, const NormalRef& q) {
   return cross_dot_normals(p, x, p, q) >= 0 && cross_dot_normals(x, q, p, q) >= 0;
 }
 
-/// Signs of det(N_fan[i], N_fan[i+1], p) for the slots of v's region. Returns a slot
-/// whose sign is negative (the one the double filter finds most negative, when it finds
-/// one: the walk heads toward p), or -1 when p is in the closed region, with `zeros` then
-/// holding the slots whose arc contains p.
-int region_test(const Polytope& P, const std::vector<ArcPlane>& planes, int v, const NormalRef& p,
-                int zeros[2], int& nzeros) {
+/// Signs of det(N_fan[i], N_fan[i+1], p) for the slots of v's region (`slots`: P's
+/// slot_planes, or null to form them here). Returns a slot whose sign is negative (the one
+/// the double filter finds most negative, when it finds one: the walk heads toward p), or
+/// -1 when p is in the closed region, with `zeros` then holding the slots whose arc
+/// contains p.
+int region_test(const Polytope& P, const ArcPlane* slots, int v, const NormalRef& p, int zeros[2],
+                int& nzeros) {
   const int b = P.fan_begin[v], n = P.fan_begin[v + 1] - b;
+  const int* const fan = P.fan_face.data() + b;
   nzeros = 0;
-  // Slot i's arc joins fan_face[i] and fan_face[i + 1]: its edge's left and right facets
-  // in either order.
-  auto flipped = [&](int i, int e) { return P.edges[e].left != P.fan_face[b + i]; };
+  auto formed = [&](int i) {
+    return cross_plane(P.unit_normals[fan[i]], P.unit_normals[fan[i + 1 == n ? 0 : i + 1]]);
+  };
+  auto plane = [&](int i) { return slots ? slots[b + i] : formed(i); };
   // The double stage of orient_arc on every slot at once.
   const UnitNormal& u = p.unit();
   bool inside = true;
   int most = -1;
   double lowest = 0;
-  for (int i = 0; i < n; ++i) {
-    const int e = P.fan_edge[b + i];
-    const ArcFilter f = arc_filter(planes[e], u);
-    const double d = flipped(i, e) ? -f.value : f.value;
-    if (!(d > f.bound)) inside = false;
-    if (d < -f.bound && d < lowest) {
-      lowest = d;
-      most = i;
+  auto scan = [&](auto&& plane_of) {
+    for (int i = 0; i < n; ++i) {
+      const ArcFilter f = arc_filter(plane_of(i), u);
+      if (!(f.value > f.bound)) inside = false;
+      if (f.value < -f.bound && f.value < lowest) {
+        lowest = f.value;
+        most = i;
+      }
     }
-  }
+  };
+  if (slots)
+    scan([&](int i) { return slots[b + i]; });
+  else
+    scan(formed);
   if (inside) return -1;
   if (most >= 0) return most;
   // Undecided slots, none certainly negative: decide each.
   for (int i = 0; i < n; ++i) {
-    const int e = P.fan_edge[b + i];
-    const int t = orient_arc(P, e, planes[e], p);
-    const int s = flipped(i, e) ? -t : t;
+    int s = orient_arc_filter(plane(i), p);
+    if (s == kUndecided)
+      s = orient_normals_undecided(NormalRef{&P, fan[i]},
+                                   NormalRef{&P, fan[i + 1 == n ? 0 : i + 1]}, p);
     if (s < 0) return i;
     if (s == 0) {
       if (nzeros == 2) throw error("internal error: a direction lies on three arcs of one region");
@@ -74,15 +82,26 @@ std::vector<ArcPlane> arc_planes(const Polytope& P) {
   parallel_chunks(P.num_edges(), 4096, [&](int begin, int end) {
     for (int e = begin; e < end; ++e) {
       const UnitNormal &q = P.unit_normals[P.edges[e].left], &r = P.unit_normals[P.edges[e].right];
-      planes[e] = {q.y * r.z - q.z * r.y, q.z * r.x - q.x * r.z, q.x * r.y - q.y * r.x,
-                   q.error + r.error};
+      planes[e] = cross_plane(q, r);
     }
   });
   return planes;
 }
 
-Location locate(const Polytope& P, const std::vector<ArcPlane>& planes, const NormalRef& p,
-                int hint) {
+std::vector<ArcPlane> slot_planes(const Polytope& P) {
+  std::vector<ArcPlane> slots(P.fan_face.size());
+  parallel_chunks(P.num_vertices(), 1024, [&](int begin, int end) {
+    for (int v = begin; v < end; ++v) {
+      const int b = P.fan_begin[v], n = P.fan_begin[v + 1] - b;
+      for (int i = 0; i < n; ++i)
+        slots[b + i] = cross_plane(P.unit_normals[P.fan_face[b + i]],
+                                   P.unit_normals[P.fan_face[b + (i + 1 == n ? 0 : i + 1)]]);
+    }
+  });
+  return slots;
+}
+
+Location locate(const Polytope& P, const ArcPlane* slots, const NormalRef& p, int hint) {
   // First one cheap step in doubles: to the neighbour of the hint with the largest support
   // value <p, x>, if it beats the hint's. It only picks where the exact walk starts, which
   // then usually finds the region at once (climbing on to the top in doubles costs a scan
@@ -106,7 +125,7 @@ Location locate(const Polytope& P, const std::vector<ArcPlane>& planes, const No
   int nzeros = 0;
   const int limit = P.num_vertices() + 16;
   for (int steps = 0; steps < limit; ++steps) {
-    const int cross = region_test(P, planes, v, p, zeros, nzeros);
+    const int cross = region_test(P, slots, v, p, zeros, nzeros);
     if (cross < 0) return classify(P, v, zeros, nzeros);
     v = P.fan_vertex[P.fan_begin[v] + cross];
   }
@@ -114,7 +133,7 @@ Location locate(const Polytope& P, const std::vector<ArcPlane>& planes, const No
   // exactly planar; on facets planar only within the tolerance it might, so fall back
   // to testing every region.
   for (v = 0; v < P.num_vertices(); ++v)
-    if (region_test(P, planes, v, p, zeros, nzeros) < 0) return classify(P, v, zeros, nzeros);
+    if (region_test(P, slots, v, p, zeros, nzeros) < 0) return classify(P, v, zeros, nzeros);
   throw error("internal error: a direction lies in no region of the Gauss map");
 }
 
@@ -130,19 +149,20 @@ int location_vertex(const Polytope& P, const Location& loc) {
   return 0;
 }
 
-std::vector<Location> locate_all(const Polytope& from, const Polytope& in) {
-  return locate_all(from, in, arc_planes(in));
-}
-
 std::vector<Location> locate_all(const Polytope& from, const Polytope& in,
-                                 const std::vector<ArcPlane>& in_planes,
                                  const std::vector<int>* hints) {
+  // A walk tests about ten slots, and forming a slot's plane costs about as much as testing
+  // it: making them all first pays only when the walks are many for the slots (at least a
+  // quarter as many), else each is formed as it is tested. Either way the same doubles.
+  std::vector<ArcPlane> slots;
+  if (4 * static_cast<std::size_t>(from.num_faces()) >= in.fan_face.size()) slots = slot_planes(in);
+  const ArcPlane* const in_slots = slots.empty() ? nullptr : slots.data();
   std::vector<Location> loc(from.num_faces());
   parallel_chunks(from.num_faces(), 256, [&](int begin, int end) {
     int hint = 0;
     for (int f = begin; f < end; ++f) {
       if (hints && (*hints)[f] >= 0) hint = (*hints)[f];
-      loc[f] = locate(in, in_planes, NormalRef{&from, f}, hint);
+      loc[f] = locate(in, in_slots, NormalRef{&from, f}, hint);
       hint = location_vertex(in, loc[f]);
     }
   });

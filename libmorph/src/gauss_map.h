@@ -27,8 +27,23 @@ struct ArcPlane {
   double x, y, z, error;
 };
 
+/// The plane q x r of the arc from unit normal q to unit normal r.
+inline ArcPlane cross_plane(const UnitNormal& q, const UnitNormal& r) {
+  return {q.y * r.z - q.z * r.y, q.z * r.x - q.x * r.z, q.x * r.y - q.y * r.x, q.error + r.error};
+}
+/// The plane of edge e's arc.
+inline ArcPlane arc_plane(const Polytope& P, int e) {
+  return cross_plane(P.unit_normals[P.edges[e].left], P.unit_normals[P.edges[e].right]);
+}
+
 /// The planes of all arcs of P's Gauss map, indexed by edge.
 std::vector<ArcPlane> arc_planes(const Polytope& P);
+
+/// The planes per fan slot (polytope.h), each oriented as the slot runs: slot s's plane is
+/// N_fan[s] x N_fan[s + 1], its edge's plane or that negated (the same doubles: the
+/// products commute and a - b = -(b - a) exactly). A region's test then reads one
+/// contiguous block, with no edge lookups.
+std::vector<ArcPlane> slot_planes(const Polytope& P);
 
 /// Sign of det(N_left, N_right, x) for edge e of P, whose arc's plane is `plane`.
 /// Its double stage alone: the sign, or kUndecided.
@@ -54,26 +69,23 @@ inline int orient_arc(const Polytope& P, int e, const ArcPlane& plane, const Nor
                                   x);
 }
 
-/// Locates the direction `p` in P's Gauss map (`planes`: its arc_planes): the vertex whose region
+/// Locates the direction `p` in P's Gauss map (`slots`: its slot_planes, or null to form each
+/// slot's plane as it is tested, cheaper for a few directions): the vertex whose region
 /// contains it in its interior (the contributing vertex), the edge whose arc contains it, or the
 /// facet whose normal has its direction. The walk starts at vertex `hint`, takes one step up
 /// the support function in doubles (only to choose where to start), then walks exactly from
 /// region to region; the answer is exact and does not depend on the hint. Expected
 /// O(distance walked).
-Location locate(const Polytope& P, const std::vector<ArcPlane>& planes, const NormalRef& p,
-                int hint);
+Location locate(const Polytope& P, const ArcPlane* slots, const NormalRef& p, int hint);
 
 /// A vertex of the feature `loc` (the contributing vertex when it is a vertex region).
 int location_vertex(const Polytope& P, const Location& loc);
 
 /// Locates every facet normal of `from` in the Gauss map of `in`, in parallel, each walk
 /// starting from the previous facet's answer (facets near in index order are usually
-/// near on the sphere).
-std::vector<Location> locate_all(const Polytope& from, const Polytope& in);
-/// The same with in's arc planes already made, and optionally a vertex of `in` per facet of
-/// `from` where its walk starts (-1: where the previous facet's ended).
+/// near on the sphere), or where `hints` says (a vertex of `in` per facet of `from`; -1:
+/// where the previous facet's ended).
 std::vector<Location> locate_all(const Polytope& from, const Polytope& in,
-                                 const std::vector<ArcPlane>& in_planes,
                                  const std::vector<int>* hints = nullptr);
 
 /// How the arc (n1, n2) meets the arc (m1, m2) (both shorter than a half circle).

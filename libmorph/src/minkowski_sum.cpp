@@ -119,10 +119,68 @@ struct WalkScratch {
 /// is inside one (`end`), is not walked on from: the arc enters it once and stays (a convex
 /// region), so its one crossing into it is found from the region before.
 void edge_facets(const Polytope& A, int a, const ArcPlane& plane_a, const Polytope& B,
-                 const std::vector<ArcPlane>& planes_b, const Location& start, const Location& end,
-                 WalkScratch& w, FacetBuffer& out) {
+                 const Location& start, const Location& end, WalkScratch& w, FacetBuffer& out) {
   const auto& ea = A.edges[a];
   const NormalRef n1{&A, ea.left}, n2{&A, ea.right};
+  const int ua = ea.from, wa = ea.to;
+  // The parallelogram of a crossing with edge e of B, whose arc's right facet's normal is on
+  // side `side_of_b` of a's great circle.
+  auto emit = [&](int e, int side_of_b) {
+    const int ub = B.edges[e].from, wb = B.edges[e].to;
+    const std::uint64_t quad[2][4] = {
+        {pair_key(wa, wb), pair_key(wa, ub), pair_key(ua, ub), pair_key(ua, wb)},   // side < 0
+        {pair_key(wa, ub), pair_key(wa, wb), pair_key(ua, wb), pair_key(ua, ub)}};  // side > 0
+    const auto& q = quad[side_of_b > 0];
+    out.corners.insert(out.corners.end(), q, q + 4);
+    out.sizes.push_back(4);
+    out.origins.push_back({FacetKind::edge,
+                           {Element::Kind::edge, A.edge_source[a]},
+                           {Element::Kind::edge, B.edge_source[e]}});
+  };
+  if (start.kind == Location::Kind::vertex && end.kind == Location::Kind::vertex) {
+    // The usual short arcs first, by the double filters alone: when a's arc starts inside
+    // region l and ends inside region r, crossing an arc of l's boundary at a point interior
+    // to both arcs is where it leaves l (a convex region, a segment from its interior leaves
+    // it once) into the region across, and from there likewise. So a crossing of the arc
+    // between l and r, or of the arcs l | w and w | r for a region w next to both, is all
+    // the walk below would find (the same crossings, the same sides). Anything else (not
+    // decided by the filters, longer arcs) takes the walk.
+    auto crosses = [&](int e, int& side_of_b) {
+      const auto& eb = B.edges[e];
+      const int s1 = orient_arc_filter(plane_a, NormalRef{&B, eb.left});
+      const int s2 = orient_arc_filter(plane_a, NormalRef{&B, eb.right});
+      if (s1 == kUndecided || s2 == kUndecided || s1 * s2 >= 0) return false;
+      const ArcPlane plane_b = arc_plane(B, e);
+      const int t1 = orient_arc_filter(plane_b, n1), t2 = orient_arc_filter(plane_b, n2);
+      if (t1 == kUndecided || t2 == kUndecided || t1 * t2 >= 0 || t1 != -s1) return false;
+      side_of_b = s2;  // as arc_contact gives it
+      return true;
+    };
+    auto edge_between = [&](int v, int u) {
+      for (int s = B.fan_begin[v]; s < B.fan_begin[v + 1]; ++s)
+        if (B.fan_vertex[s] == u) return B.fan_edge[s];
+      return -1;
+    };
+    const int l = start.index, r = end.index;
+    int side1, side2;
+    if (const int e = edge_between(l, r); e >= 0) {
+      if (crosses(e, side1)) {
+        emit(e, side1);
+        return;
+      }
+    } else {
+      for (int s = B.fan_begin[l]; s < B.fan_begin[l + 1]; ++s) {
+        const int e2 = edge_between(B.fan_vertex[s], r);
+        if (e2 < 0) continue;
+        const int e1 = B.fan_edge[s];
+        if (crosses(e1, side1) && crosses(e2, side2)) {  // in B's edge order
+          emit(std::min(e1, e2), e1 < e2 ? side1 : side2);
+          emit(std::max(e1, e2), e1 < e2 ? side2 : side1);
+          return;
+        }
+      }
+    }
+  }
   const int stamp = a + 1;
   w.queue.clear();
   auto visit = [&](int v) {
@@ -169,10 +227,12 @@ void edge_facets(const Polytope& A, int a, const ArcPlane& plane_a, const Polyto
       w.edge_stamp[e] = stamp;
       const auto& eb = B.edges[e];
       int s1 = side(eb.left), s2 = side(eb.right);
+      if (s1 != kUndecided && s2 != kUndecided && s1 * s2 > 0) continue;  // as below, sooner
+      const ArcPlane plane_b = arc_plane(B, e);
       if (s1 == kUndecided || s2 == kUndecided) {
         // Nearly on a's great circle. Before deciding exactly: a's arc strictly on one side
         // of b's great circle touches nothing.
-        const int u1 = orient_arc_filter(planes_b[e], n1), u2 = orient_arc_filter(planes_b[e], n2);
+        const int u1 = orient_arc_filter(plane_b, n1), u2 = orient_arc_filter(plane_b, n2);
         if (u1 != kUndecided && u2 != kUndecided && u1 * u2 > 0) continue;
         s1 = exact_side(eb.left);
         s2 = exact_side(eb.right);
@@ -180,8 +240,8 @@ void edge_facets(const Polytope& A, int a, const ArcPlane& plane_a, const Polyto
       if (s1 * s2 > 0) continue;  // b's arc strictly on one side of a's great circle
       int t1 = 0, t2 = 0;
       if (arc_contact_needs_t(s1, s2)) {
-        t1 = orient_arc(B, e, planes_b[e], n1);
-        t2 = orient_arc(B, e, planes_b[e], n2);
+        t1 = orient_arc(B, e, plane_b, n1);
+        t2 = orient_arc(B, e, plane_b, n2);
       }
       const ArcContact c =
           arc_contact(n1, n2, NormalRef{&B, eb.left}, NormalRef{&B, eb.right}, s1, s2, t1, t2);
@@ -190,38 +250,44 @@ void edge_facets(const Polytope& A, int a, const ArcPlane& plane_a, const Polyto
     }
   }
   std::sort(crossings.begin(), crossings.end());
-  const int ua = ea.from, wa = ea.to;
-  for (const auto& [e, side_of_b] : crossings) {
-    const int ub = B.edges[e].from, wb = B.edges[e].to;
-    const std::uint64_t quad[2][4] = {
-        {pair_key(wa, wb), pair_key(wa, ub), pair_key(ua, ub), pair_key(ua, wb)},   // side < 0
-        {pair_key(wa, ub), pair_key(wa, wb), pair_key(ua, wb), pair_key(ua, ub)}};  // side > 0
-    const auto& q = quad[side_of_b > 0];
-    out.corners.insert(out.corners.end(), q, q + 4);
-    out.sizes.push_back(4);
-    out.origins.push_back({FacetKind::edge,
-                           {Element::Kind::edge, A.edge_source[a]},
-                           {Element::Kind::edge, B.edge_source[e]}});
-  }
+  for (const auto& [e, side_of_b] : crossings) emit(e, side_of_b);
 }
 
-/// Where to start locating each facet g of B in A's Gauss map, from A's facets located
-/// in B's: N_g lies on the region of each of its corners c, so near the normal of any
-/// facet f of A whose contributing vertex is c, and a corner of f has its region near N_f.
-/// -1 where no corner of g contributes.
-std::vector<int> walk_starts(const Polytope& A, const Polytope& B,
-                             const std::vector<Location>& loc_a) {
-  std::vector<int> facet_at(B.num_vertices(), -1);  // a facet of A contributed to by the vertex
-  for (int f = 0; f < A.num_faces(); ++f)
-    if (loc_a[f].kind == Location::Kind::vertex) facet_at[loc_a[f].index] = f;
-  std::vector<int> starts(B.num_faces(), -1);
-  parallel_chunks(B.num_faces(), 4096, [&](int begin, int end) {
-    for (int g = begin; g < end; ++g)
-      for (int k = 0; k < B.degree(g); ++k)
-        if (const int f = facet_at[B.corner(g, k)]; f >= 0) {
-          starts[g] = A.corner(f, 0);
-          break;
+/// Where to start locating each facet f of X in Y's Gauss map, from Y's facets located in
+/// X's (loc_y): N_f is the common corner of the regions of f's corners in X's map, so the
+/// facets of Y whose normals those regions contain are the ones near it; the walk starts
+/// at a corner of the nearest of them in the first such region that has any (nearest in
+/// doubles: it only picks where the exact walk starts; one region's scan costs less than
+/// the steps the others would spare). -1 when those regions contain none.
+std::vector<int> walk_starts(const Polytope& X, const Polytope& Y,
+                             const std::vector<Location>& loc_y) {
+  // Y's facets by the vertex of X whose region contains their normal (a counting sort).
+  std::vector<int> first(X.num_vertices() + 1, 0);
+  for (const Location& l : loc_y)
+    if (l.kind == Location::Kind::vertex) ++first[l.index + 1];
+  std::partial_sum(first.begin(), first.end(), first.begin());
+  std::vector<int> next(first.begin(), first.end() - 1), by_region(first.back());
+  for (int g = 0; g < Y.num_faces(); ++g)
+    if (loc_y[g].kind == Location::Kind::vertex) by_region[next[loc_y[g].index]++] = g;
+  std::vector<int> starts(X.num_faces(), -1);
+  parallel_chunks(X.num_faces(), 4096, [&](int begin, int end) {
+    for (int f = begin; f < end; ++f) {
+      const UnitNormal& n = X.unit_normals[f];
+      double best = -2;  // below any dot product of unit vectors
+      int nearest = -1;
+      for (int k = 0; k < X.degree(f) && nearest < 0; ++k) {  // the first region with any
+        const int u = X.corner(f, k);
+        for (int i = first[u]; i < first[u + 1]; ++i) {
+          const UnitNormal& m = Y.unit_normals[by_region[i]];
+          const double d = n.x * m.x + n.y * m.y + n.z * m.z;
+          if (d > best) {
+            best = d;
+            nearest = by_region[i];
+          }
         }
+      }
+      if (nearest >= 0) starts[f] = Y.corner(nearest, 0);
+    }
   });
   return starts;
 }
@@ -248,45 +314,61 @@ SumFacets gather(std::initializer_list<const std::vector<FacetBuffer>*> lists) {
 }  // namespace
 
 SumFacets fims_facets(const Polytope& A, const Polytope& B) {
-  const std::vector<ArcPlane> planes_a = arc_planes(A), planes_b = arc_planes(B);
-  // The contributing vertices of A's facets; where B's facets sit on A.
-  const std::vector<Location> loc_a = locate_all(A, B, planes_b);
-  // From here two independent branches (side by side when threads allow, each loop in
-  // parallel chunks too): B's facets located in A and the corner facets, and the translated
-  // and edge facets, which need only loc_a. Fewer joins than one loop after another, and
-  // the buffers are gathered in the same order whatever the schedule.
+  // A's arc planes serve the edge loop (B's are formed as its walks need them).
+  const std::vector<ArcPlane> planes_a = arc_planes(A);
+  // Two independent branches (side by side when threads allow, each loop in parallel
+  // chunks too): the corner facets, which need B's facets located on A's map (loc_b), and
+  // the translated and edge facets, which need A's located on B's (loc_a). The facets of
+  // one are located first, walking on the coarser map (fewer vertices: shorter walks from
+  // the previous facet's answer), and those of the other then start next to the nearest
+  // of them (walk_starts), in the branch that needs them. Fewer joins than one loop after
+  // another, and the buffers are gathered in the same order whatever the schedule.
+  std::vector<Location> loc_a, loc_b;
   std::vector<FacetBuffer> translated, corner, edge;
-  run_both(
-      [&] {
-        const std::vector<int> hints_b = walk_starts(A, B, loc_a);
-        const std::vector<Location> loc_b = locate_all(B, A, planes_a, &hints_b);
-        // Corner facets: one per facet of B whose normal is not also a facet normal of A.
-        corner = in_chunks(B.num_faces(), [&](int begin, int end, FacetBuffer& out) {
-          for (int g = begin; g < end; ++g)
-            if (loc_b[g].kind != Location::Kind::face)
-              facet_at_normal(B, g, A, loc_b[g], false, out);
-        });
-      },
-      [&] {
-        // Translated facets: one per facet of A.
-        translated = in_chunks(A.num_faces(), [&](int begin, int end, FacetBuffer& out) {
-          for (int f = begin; f < end; ++f) facet_at_normal(A, f, B, loc_a[f], true, out);
-        });
-        // Edge facets: for every edge of A whose two facets have different contributing
-        // vertices, the edges of B whose arcs its arc crosses.
-        tbb::enumerable_thread_specific<WalkScratch> scratch([&] { return WalkScratch(B); });
-        edge = in_chunks(A.num_edges(), [&](int begin, int end, FacetBuffer& out) {
-          WalkScratch& w = scratch.local();
-          for (int a = begin; a < end; ++a) {
-            const auto& l = loc_a[A.edges[a].left];
-            const auto& r = loc_a[A.edges[a].right];
-            if (l.kind == Location::Kind::vertex && r.kind == Location::Kind::vertex &&
-                l.index == r.index)
-              continue;
-            edge_facets(A, a, planes_a[a], B, planes_b, l, r, w, out);
-          }
-        });
-      });
+  auto corner_facets = [&] {
+    // Corner facets: one per facet of B whose normal is not also a facet normal of A.
+    corner = in_chunks(B.num_faces(), [&](int begin, int end, FacetBuffer& out) {
+      for (int g = begin; g < end; ++g)
+        if (loc_b[g].kind != Location::Kind::face) facet_at_normal(B, g, A, loc_b[g], false, out);
+    });
+  };
+  auto translated_and_edge_facets = [&] {
+    // Translated facets: one per facet of A.
+    translated = in_chunks(A.num_faces(), [&](int begin, int end, FacetBuffer& out) {
+      for (int f = begin; f < end; ++f) facet_at_normal(A, f, B, loc_a[f], true, out);
+    });
+    // Edge facets: for every edge of A whose two facets have different contributing
+    // vertices, the edges of B whose arcs its arc crosses.
+    tbb::enumerable_thread_specific<WalkScratch> scratch([&] { return WalkScratch(B); });
+    edge = in_chunks(A.num_edges(), [&](int begin, int end, FacetBuffer& out) {
+      WalkScratch& w = scratch.local();
+      for (int a = begin; a < end; ++a) {
+        const auto& l = loc_a[A.edges[a].left];
+        const auto& r = loc_a[A.edges[a].right];
+        if (l.kind == Location::Kind::vertex && r.kind == Location::Kind::vertex &&
+            l.index == r.index)
+          continue;
+        edge_facets(A, a, planes_a[a], B, l, r, w, out);
+      }
+    });
+  };
+  if (A.num_vertices() <= B.num_vertices()) {
+    loc_b = locate_all(B, A);
+    run_both(corner_facets, [&] {
+      const std::vector<int> hints_a = walk_starts(A, B, loc_b);
+      loc_a = locate_all(A, B, &hints_a);
+      translated_and_edge_facets();
+    });
+  } else {
+    loc_a = locate_all(A, B);
+    run_both(
+        [&] {
+          const std::vector<int> hints_b = walk_starts(B, A, loc_a);
+          loc_b = locate_all(B, A, &hints_b);
+          corner_facets();
+        },
+        translated_and_edge_facets);
+  }
   return gather({&translated, &corner, &edge});
 }
 
