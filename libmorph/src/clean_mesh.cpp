@@ -677,7 +677,7 @@ Soup hull_facets(const std::vector<V3<double>>& points, const Soup& facets) {
 }  // namespace
 
 Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& face_begin,
-                const std::vector<int>& corners, std::vector<int>* source) {
+                std::vector<int> corners, std::vector<int>* source) {
   constexpr int kPairwiseDegree = 16;  // facets up to this degree are checked corner by corner
   const int n = static_cast<int>(points.size());
   const int nf = static_cast<int>(face_begin.size()) - 1;
@@ -753,7 +753,7 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
   }
   if (as_given) {
     soup.begin = face_begin;
-    soup.vertex = corners;
+    soup.vertex = std::move(corners);
     soup.source.resize(nf);
     std::iota(soup.source.begin(), soup.source.end(), 0);
   } else {
