@@ -219,13 +219,26 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
   std::vector<int> reference(nf), last_member(nf);
   std::iota(reference.begin(), reference.end(), 0);
   std::iota(last_member.begin(), last_member.end(), 0);
-  // All vertices of group `g` within `limit` of the plane of facet `ref`.
-  auto holds = [&](int ref, int g) {
+  // All vertices of group `g` within `limit` of the plane of facet `ref`; `edge`: g's corner
+  // on the edge that the two groups share.
+  auto holds = [&](int ref, int g, int edge) {
     const FacetGeometry& p = geo[ref];
     if (is_thin(p, limit)) return false;
+    const auto off = [&](int c) {
+      return std::abs(dot(p.normal, points[soup.vertex[c]]) - p.offset) > limit;
+    };
+    if (next_member[g] < 0) {
+      // One facet (the group is named by it, and has the edge): its corners from the one
+      // after the shared edge on, as the edge's ends are on the plane when the groups
+      // already meet there. Which corner fails first does not change the answer.
+      const int d = soup.degree(g);
+      for (int i = 0, c = k.next[k.next[edge]]; i < d; ++i, c = k.next[c])
+        if (off(c)) return false;
+      return true;
+    }
     for (int f = g; f >= 0; f = next_member[f])
       for (int c = soup.begin[f]; c < soup.begin[f + 1]; ++c)
-        if (std::abs(dot(p.normal, points[soup.vertex[c]]) - p.offset) > limit) return false;
+        if (off(c)) return false;
     return true;
   };
   const int nc = static_cast<int>(soup.vertex.size());
@@ -234,9 +247,13 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
     if (t < c) continue;
     int a = sets.find(k.face[c]), b = sets.find(k.face[t]);
     if (a == b) continue;
-    if (geo[reference[a]].twice_area < geo[reference[b]].twice_area) std::swap(a, b);
+    int edge_b = t;  // b's corner on the edge
+    if (geo[reference[a]].twice_area < geo[reference[b]].twice_area) {
+      std::swap(a, b);
+      edge_b = c;
+    }
     // a has the larger reference facet.
-    if (!holds(reference[a], b)) continue;
+    if (!holds(reference[a], b, edge_b)) continue;
     const int root = std::min(a, b), other = std::max(a, b);
     sets.unite(a, b);  // names the joined set `root`
     reference[root] = reference[a];
@@ -253,15 +270,22 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
 /// reflex by more than `limit`.
 bool convex_polygon(const std::vector<V3<double>>& points, const int* cycle, int d,
                     const V3<double>& normal, double limit) {
+  // Each corner's incoming side is the previous corner's outgoing one (the same difference).
+  const V3<double>* a = &points[cycle[0]];
+  const V3<double>* b = &points[cycle[1 % d]];
+  V3<double> ab = *b - *a;
   for (int i = 0; i < d; ++i) {
-    const auto& a = points[cycle[i]];
-    const auto& b = points[cycle[i + 1 < d ? i + 1 : i + 1 - d]];
-    const auto& c = points[cycle[i + 2 < d ? i + 2 : i + 2 - d]];
+    const V3<double>& c = points[cycle[i + 2 < d ? i + 2 : i + 2 - d]];
+    const V3<double> bc = c - *b;
     // Height of b over the chord a-c times the chord's length, positive when the corner
     // at b is convex; a convex corner (most) needs no division.
-    const double scaled_height = dot(cross(b - a, c - b), normal);
+    const double scaled_height = dot(cross(ab, bc), normal);
+    const V3<double>& corner_a = *a;
+    a = b;
+    b = &c;
+    ab = bc;
     if (scaled_height >= 0) continue;
-    const V3<double> ac = c - a;
+    const V3<double> ac = c - corner_a;
     const double base = std::sqrt(dot(ac, ac));
     if (base > 0 && scaled_height / base < -limit) return false;
   }
