@@ -61,6 +61,104 @@ TEST_CASE("clean_mesh merges a split facet and drops the vertices in the middle 
   CHECK(std::count(source.begin(), source.end(), 2) == 0);
 }
 
+// A cube (vertex x + 2y + 4z) from a soup: its faces as given, unless listed in `split`, which
+// become two triangles along a diagonal; `extra` facets are appended.
+std::vector<int> cube_soup(const std::set<int>& split, const std::vector<std::vector<int>>& extra,
+                           std::vector<int>& begin) {
+  const std::vector<std::vector<int>> faces = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                               {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  std::vector<int> corners;
+  begin.assign(1, 0);
+  auto add = [&](const std::vector<int>& f) {
+    corners.insert(corners.end(), f.begin(), f.end());
+    begin.push_back(static_cast<int>(corners.size()));
+  };
+  for (int i = 0; i < 6; ++i) {
+    const auto& f = faces[i];
+    if (split.count(i)) {
+      add({f[0], f[1], f[2]});
+      add({f[0], f[2], f[3]});
+    } else {
+      add(f);
+    }
+  }
+  for (const auto& f : extra) add(f);
+  return corners;
+}
+
+// Every face of `mesh` a square on one face plane of the unit cube, all six of them, with
+// consistent twins.
+void check_cube(const morph::Mesh& mesh) {
+  CHECK(mesh.n_vertices() == 8);
+  REQUIRE(mesh.n_faces() == 6);
+  CHECK(mesh.n_edges() == 12);
+  std::set<int> planes;
+  for (auto f : mesh.faces()) {
+    CHECK(mesh.valence(f) == 4);
+    for (int axis = 0; axis < 3; ++axis)
+      for (int side = 0; side < 2; ++side) {
+        bool on = true;
+        for (auto v : mesh.fv_range(f)) on = on && mesh.point(v)[axis] == side;
+        if (on) planes.insert(2 * axis + side);
+      }
+  }
+  CHECK(planes.size() == 6);
+  for (auto h : mesh.halfedges()) {
+    CHECK_FALSE(mesh.is_boundary(h));
+    const auto o = mesh.opposite_halfedge_handle(h);
+    CHECK(mesh.from_vertex_handle(h) == mesh.to_vertex_handle(o));
+    CHECK(mesh.face_handle(h) != mesh.face_handle(o));
+    CHECK(mesh.face_handle(mesh.next_halfedge_handle(h)) == mesh.face_handle(h));
+  }
+}
+
+std::vector<V3<double>> cube_points() {
+  std::vector<V3<double>> points;
+  for (int v = 0; v < 8; ++v)
+    points.push_back({double(v & 1), double((v >> 1) & 1), double(v >> 2)});
+  return points;
+}
+
+// The merged soup's twins are checked only where a group merged or a vertex went; the
+// facets left alone keep theirs. Any subset of the faces split: the cube each time.
+TEST_CASE("clean_mesh merges some groups and keeps the others") {
+  const std::vector<V3<double>> points = cube_points();
+  for (int mask = 0; mask < 64; ++mask) {
+    std::set<int> split;
+    for (int i = 0; i < 6; ++i)
+      if (mask >> i & 1) split.insert(i);
+    std::vector<int> begin, source;
+    const std::vector<int> corners = cube_soup(split, {}, begin);
+    CAPTURE(mask);
+    const morph::Mesh mesh = clean_mesh(points, begin, corners, &source);
+    check_cube(mesh);
+    // A face alone keeps its own source; a split face takes its first half's (equal areas).
+    std::set<int> sources(source.begin(), source.end());
+    CHECK(sources.size() == 6);
+  }
+}
+
+// Soups that are not closed manifolds are still found out (and rebuilt from the hull of
+// their points): a facet twice, a facet missing, a facet reversed, with some faces split so
+// that their groups merge.
+TEST_CASE("clean_mesh rebuilds soups that are not closed manifolds") {
+  const std::vector<V3<double>> points = cube_points();
+  for (const std::set<int>& split : {std::set<int>{}, std::set<int>{0, 3}, std::set<int>{1}}) {
+    std::vector<int> begin, source;
+    std::vector<int> corners = cube_soup(split, {{1, 3, 7, 5}}, begin);  // a facet twice
+    check_cube(clean_mesh(points, begin, corners, &source));
+    corners = cube_soup(split, {}, begin);
+    // The last face (x = 1, never split) missing.
+    corners.resize(corners.size() - 4);
+    begin.pop_back();
+    check_cube(clean_mesh(points, begin, corners, &source));
+    // Reversed.
+    corners = cube_soup(split, {}, begin);
+    std::reverse(corners.end() - 4, corners.end());
+    check_cube(clean_mesh(points, begin, corners, &source));
+  }
+}
+
 // The unit cube with each face an n x n grid of quads whose inner points are off their
 // face's plane by less than the feature size: more facets, corners and points than one
 // chunk of each of clean_mesh's parallel loops. Every grid merges into one square.

@@ -24,6 +24,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <memory>
 #include <numeric>
 #include <optional>
 
@@ -49,35 +50,53 @@ struct Soup {
   }
 };
 
+/// An array of ints left uninitialised (std::vector zero-fills): the per-corner arrays
+/// below are written in full before they are read, and filling them with zeros first
+/// costs about as much as the passes that write them.
+class Ints {
+ public:
+  Ints() = default;
+  explicit Ints(int n) : data_(std::make_unique_for_overwrite<int[]>(n)) {}
+  int& operator[](int i) { return data_[i]; }
+  int operator[](int i) const { return data_[i]; }
+  int* data() { return data_.get(); }
+  const int* data() const { return data_.get(); }
+
+ private:
+  std::unique_ptr<int[]> data_;
+};
+
 /// Halfedge connectivity of a soup: corner c is the edge from vertex[c] to the next
 /// corner's vertex; twin[c] the corner of the opposite edge.
 struct Connectivity {
-  std::vector<int> face, next, prev, twin;
+  Ints face, next, prev, twin;
+  Ints first_out;  // from `connect` only: the first corner leaving each point (-1: none)
 };
 
 // Chunk sizes of the parallel loops: large enough that a chunk pays for its task, small
 // enough that a result of a few thousand facets is split between two threads.
 constexpr int kFacetGrain = 512;
 constexpr int kCornerGrain = 2048;
+constexpr int kVertexGrain = 1024;
 
 /// The facet, next and previous corner of every corner (no twins yet).
 Connectivity facet_cycles(const Soup& soup) {
   const int nc = static_cast<int>(soup.vertex.size());
-  Connectivity k;
-  k.face.resize(nc);
-  k.next.resize(nc);
-  k.prev.resize(nc);
+  Connectivity k{Ints(nc), Ints(nc), Ints(nc), {}, {}};
   parallel_chunks(soup.size(), kFacetGrain, [&](int first, int last) {
+    // Plain pointers: the writes through them could alias the captured arrays' own pointers.
+    int *face = k.face.data(), *next = k.next.data(), *prev = k.prev.data();
+    const int* begin = soup.begin.data();
     for (int f = first; f < last; ++f) {
-      const int b = soup.begin[f], e = soup.begin[f + 1];
+      const int b = begin[f], e = begin[f + 1];
       if (b == e) continue;
       for (int c = b; c < e; ++c) {
-        k.face[c] = f;
-        k.next[c] = c + 1;
-        k.prev[c] = c - 1;
+        face[c] = f;
+        next[c] = c + 1;
+        prev[c] = c - 1;
       }
-      k.next[e - 1] = b;
-      k.prev[b] = e - 1;
+      next[e - 1] = b;
+      prev[b] = e - 1;
     }
   });
   return k;
@@ -85,44 +104,61 @@ Connectivity facet_cycles(const Soup& soup) {
 
 /// Twins of every corner, or nothing when the soup is not a closed, oriented 2-manifold
 /// (an edge used twice in one direction or only once, a vertex with several fans).
+/// Also the first corner (in soup order) leaving each point (-1: none).
 std::optional<Connectivity> connect(int num_points, const Soup& soup) {
   const int nc = static_cast<int>(soup.vertex.size());
   Connectivity k = facet_cycles(soup);
-  k.twin.assign(nc, -1);
+  k.twin = Ints(nc);  // each corner's twin is set below (each is the prev of one corner)
+  k.first_out = Ints(num_points);
   // Outgoing corners of each vertex (counting sort).
-  std::vector<int> out_begin(num_points + 1, 0), out(nc);
+  std::vector<int> out_begin(num_points + 1, 0);
+  Ints out(nc);
   for (int c = 0; c < nc; ++c) ++out_begin[soup.vertex[c]];
   std::partial_sum(out_begin.begin(), out_begin.end(), out_begin.begin());  // ends, until filled
   for (int c = nc - 1; c >= 0; --c) out[--out_begin[soup.vertex[c]]] = c;
-  auto target = [&](int c) { return soup.vertex[k.next[c]]; };
-  // Each corner d ending at v (u -> v) precedes one leaving v; its twin is the edge
-  // v -> u, looked up by its end while the edges leaving v are marked.
-  std::vector<int> edge_to(num_points, -1);
-  for (int v = 0; v < num_points; ++v) {
-    for (int i = out_begin[v]; i < out_begin[v + 1]; ++i) {
-      int& e = edge_to[target(out[i])];
-      if (e >= 0) return std::nullopt;  // v -> w twice
-      e = out[i];
-    }
-    for (int i = out_begin[v]; i < out_begin[v + 1]; ++i) {
-      const int d = k.prev[out[i]];
-      const int t = edge_to[soup.vertex[d]];
-      if (t < 0) return std::nullopt;  // u -> v has no opposite edge
-      k.twin[d] = t;
-    }
-    for (int i = out_begin[v]; i < out_begin[v + 1]; ++i) edge_to[target(out[i])] = -1;
-    // One fan per vertex: turning from an outgoing edge to the next reaches them all
-    // (the twins it turns over, of edges ending at v, are all known now).
-    const int n = out_begin[v + 1] - out_begin[v];
-    if (n == 0) continue;
-    const int start = out[out_begin[v]];
-    int c = start, steps = 0;
-    do {
-      c = k.twin[k.prev[c]];
-      if (++steps > n) return std::nullopt;
-    } while (c != start);
-    if (steps != n) return std::nullopt;
-  }
+  // By place in `out`: the place of the next edge leaving the same vertex around it.
+  Ints turn(nc);
+  // Vertices are independent (each writes the twins of the edges ending at it): in parallel.
+  std::atomic<bool> manifold{true};
+  parallel_chunks(num_points, kVertexGrain, [&](int first, int last) {
+    // Each corner d ending at v (u -> v) precedes one leaving v; its twin is the edge
+    // v -> u, looked up by its end while the edges leaving v are marked (by their place
+    // among them).
+    std::vector<int> edge_to(num_points, -1);
+    // Plain pointers: the writes through them could alias the captured arrays' own pointers.
+    const int *vertex = soup.vertex.data(), *next = k.next.data(), *prev = k.prev.data();
+    const int* order = out.data();
+    int *twin = k.twin.data(), *place = turn.data(), *mark = edge_to.data();
+    const auto fan = [&](int v) {
+      const int b = out_begin[v], n = out_begin[v + 1] - b;
+      k.first_out[v] = n > 0 ? order[b] : -1;
+      if (n == 0) return true;
+      for (int i = 0; i < n; ++i) {
+        int& e = mark[vertex[next[order[b + i]]]];
+        if (e >= 0) return false;  // v -> w twice
+        e = i;
+      }
+      for (int i = 0; i < n; ++i) {
+        const int d = prev[order[b + i]];
+        const int t = mark[vertex[d]];
+        if (t < 0) return false;  // u -> v has no opposite edge
+        twin[d] = order[b + t];
+        place[b + i] = t;  // twin[prev[out[b + i]]] is out[b + t]
+      }
+      for (int i = 0; i < n; ++i) mark[vertex[next[order[b + i]]]] = -1;
+      // One fan per vertex: turning from an outgoing edge to the next (over the twin of the
+      // edge before it) reaches them all.
+      int i = 0, steps = 0;
+      do {
+        i = place[b + i];
+        if (++steps > n) return false;
+      } while (i != 0);
+      return steps == n;
+    };
+    for (int v = first; v < last; ++v)
+      if (!fan(v)) return manifold.store(false, std::memory_order_relaxed);
+  });
+  if (!manifold.load()) return std::nullopt;
   return k;
 }
 
@@ -183,13 +219,26 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
   std::vector<int> reference(nf), last_member(nf);
   std::iota(reference.begin(), reference.end(), 0);
   std::iota(last_member.begin(), last_member.end(), 0);
-  // All vertices of group `g` within `limit` of the plane of facet `ref`.
-  auto holds = [&](int ref, int g) {
+  // All vertices of group `g` within `limit` of the plane of facet `ref`; `edge`: g's corner
+  // on the edge that the two groups share.
+  auto holds = [&](int ref, int g, int edge) {
     const FacetGeometry& p = geo[ref];
     if (is_thin(p, limit)) return false;
+    const auto off = [&](int c) {
+      return std::abs(dot(p.normal, points[soup.vertex[c]]) - p.offset) > limit;
+    };
+    if (next_member[g] < 0) {
+      // One facet (the group is named by it, and has the edge): its corners from the one
+      // after the shared edge on, as the edge's ends are on the plane when the groups
+      // already meet there. Which corner fails first does not change the answer.
+      const int d = soup.degree(g);
+      for (int i = 0, c = k.next[k.next[edge]]; i < d; ++i, c = k.next[c])
+        if (off(c)) return false;
+      return true;
+    }
     for (int f = g; f >= 0; f = next_member[f])
       for (int c = soup.begin[f]; c < soup.begin[f + 1]; ++c)
-        if (std::abs(dot(p.normal, points[soup.vertex[c]]) - p.offset) > limit) return false;
+        if (off(c)) return false;
     return true;
   };
   const int nc = static_cast<int>(soup.vertex.size());
@@ -198,9 +247,13 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
     if (t < c) continue;
     int a = sets.find(k.face[c]), b = sets.find(k.face[t]);
     if (a == b) continue;
-    if (geo[reference[a]].twice_area < geo[reference[b]].twice_area) std::swap(a, b);
+    int edge_b = t;  // b's corner on the edge
+    if (geo[reference[a]].twice_area < geo[reference[b]].twice_area) {
+      std::swap(a, b);
+      edge_b = c;
+    }
     // a has the larger reference facet.
-    if (!holds(reference[a], b)) continue;
+    if (!holds(reference[a], b, edge_b)) continue;
     const int root = std::min(a, b), other = std::max(a, b);
     sets.unite(a, b);  // names the joined set `root`
     reference[root] = reference[a];
@@ -217,27 +270,47 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
 /// reflex by more than `limit`.
 bool convex_polygon(const std::vector<V3<double>>& points, const int* cycle, int d,
                     const V3<double>& normal, double limit) {
+  // Each corner's incoming side is the previous corner's outgoing one (the same difference).
+  const V3<double>* a = &points[cycle[0]];
+  const V3<double>* b = &points[cycle[1 % d]];
+  V3<double> ab = *b - *a;
   for (int i = 0; i < d; ++i) {
-    const auto& a = points[cycle[i]];
-    const auto& b = points[cycle[i + 1 < d ? i + 1 : i + 1 - d]];
-    const auto& c = points[cycle[i + 2 < d ? i + 2 : i + 2 - d]];
+    const V3<double>& c = points[cycle[i + 2 < d ? i + 2 : i + 2 - d]];
+    const V3<double> bc = c - *b;
     // Height of b over the chord a-c times the chord's length, positive when the corner
     // at b is convex; a convex corner (most) needs no division.
-    const double scaled_height = dot(cross(b - a, c - b), normal);
+    const double scaled_height = dot(cross(ab, bc), normal);
+    const V3<double>& corner_a = *a;
+    a = b;
+    b = &c;
+    ab = bc;
     if (scaled_height >= 0) continue;
-    const V3<double> ac = c - a;
+    const V3<double> ac = c - corner_a;
     const double base = std::sqrt(dot(ac, ac));
     if (base > 0 && scaled_height / base < -limit) return false;
   }
   return true;
 }
 
+/// The twins of a merged soup's corners, read off the unmerged soup's, and which of them
+/// `connect_with` still has to check. A merged corner whose chain is one boundary corner
+/// c, between two kept vertices, has the chain of twin[c] as its twin, also one corner:
+/// they are mutual and reverse by construction. A kept vertex whose edges all separate two
+/// groups and lead to kept vertices has, in the merged soup, the fan it had (each of its
+/// corners one chain, turning from one to the next over the same twins), which `connect`
+/// found to be one, with no edge twice. Only the other corners and vertices are checked.
+struct MergedTwins {
+  Ints twin;
+  std::vector<char> check_corner;  // per merged corner
+  std::vector<char> check_vertex;  // per point
+};
+
 /// Passes 2 and 3 on a closed manifold soup: the polygons of its coplanar groups go to
 /// `out` (`changed` tells whether any merged; `out` is untouched if not). False when a
 /// group is not one disc or its polygon is not convex; `strict`: also when a needle finds
 /// no group.
 bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, const Connectivity& k,
-                    double limit, bool strict, Soup& merged, std::vector<int>& merged_twin,
+                    double limit, bool strict, Soup& merged, MergedTwins& merged_twins,
                     bool& changed) {
   const int nf = soup.size();
   std::vector<FacetGeometry> geo(nf);
@@ -254,45 +327,60 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
         if (alone) return false;
       }
   const int nc = static_cast<int>(soup.vertex.size());
-  std::vector<int> corner_group(nc);  // looked up several times per corner below
+  Ints corner_group(nc);  // looked up several times per corner below
   parallel_chunks(nc, kCornerGrain, [&](int first, int last) {
     for (int c = first; c < last; ++c) corner_group[c] = groups.of[k.face[c]];
   });
   const auto group = [&](int c) { return corner_group[c]; };
-  // Vertices keep their place when at least three groups meet there.
-  std::vector<char> keep(points.size(), 0), seen(points.size(), 0);
-  bool dropped = false;
-  for (int c = 0; c < nc; ++c) {
-    const int v = soup.vertex[c];
-    if (seen[v]) continue;
-    seen[v] = 1;
-    int g1 = -1, g2 = -1, distinct = 0, e = c;
-    do {
-      const int g = group(e);
-      if (g != g1 && g != g2) {
-        if (g1 < 0)
-          g1 = g;
-        else if (g2 < 0)
-          g2 = g;
-        ++distinct;
-      }
-      e = k.twin[k.prev[e]];
-    } while (e != c && distinct < 3);
-    keep[v] = distinct >= 3;
-    dropped = dropped || !keep[v];
-  }
-  changed = groups.merged || dropped;
+  // Vertices keep their place when at least three groups meet there (each vertex walks
+  // its own fan: in parallel).
+  const int np = static_cast<int>(points.size());
+  std::vector<char> keep(np, 0);
+  std::atomic<bool> dropped{false};
+  parallel_chunks(np, kVertexGrain, [&](int first, int last) {
+    bool here = false;
+    for (int v = first; v < last; ++v) {
+      const int c = k.first_out[v];
+      if (c < 0) continue;
+      int g1 = -1, g2 = -1, distinct = 0, e = c;
+      do {
+        const int g = group(e);
+        if (g != g1 && g != g2) {
+          if (g1 < 0)
+            g1 = g;
+          else if (g2 < 0)
+            g2 = g;
+          ++distinct;
+        }
+        e = k.twin[k.prev[e]];
+      } while (e != c && distinct < 3);
+      keep[v] = distinct >= 3;
+      here = here || !keep[v];
+    }
+    if (here) dropped.store(true, std::memory_order_relaxed);
+  });
+  changed = groups.merged || dropped.load();
   if (!changed) return true;
   // The boundary of each group, walked from its first boundary corner.
   Soup out;
-  out.begin.reserve(nf + 1);
-  out.vertex.resize(nc);  // no more corners than the soup's; filled up to `size`
-  int size = 0;
-  out.source.reserve(nf);
+  // No more polygons and corners than the soup's: filled up to `polygons` and `size`
+  // (push_back, not inlined, costs more than the rest of the walk of a triangle).
+  out.begin.resize(nf + 1);
+  out.vertex.resize(nc);
+  out.source.resize(nf);
+  int polygons = 0, size = 0;
   // A merged corner is a chain of boundary corners from a kept vertex to the next. The
   // chain of its twin starts where the twin of its chain's last corner does.
-  std::vector<int> chain_of(nc);     // boundary corner starting a chain -> merged corner
-  std::vector<int> chain_end(nc);    // merged corner -> its chain's last boundary corner
+  Ints chain_of(nc);   // boundary corner starting a chain -> merged corner
+  Ints chain_end(nc);  // merged corner -> its chain's last boundary corner
+  // Merged corners of more than one boundary corner, vertices with an edge inside a group
+  // or to a vertex that goes: what connect_with checks (see MergedTwins).
+  std::vector<char> long_chain(nc, 0), check_vertex(np, 0);
+  const auto lengthen = [&](int m, int c) {
+    chain_end[m] = c;
+    long_chain[m] = 1;
+    check_vertex[out.vertex[m]] = 1;
+  };
   std::vector<int> largest(nf, -1);  // the group's largest facet gives its source
   for (int f = 0; f < nf; ++f) {
     int& l = largest[groups.of[f]];
@@ -319,7 +407,7 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
       } else if (size == first) {
         before_first = c;
       } else {
-        chain_end[size - 1] = c;
+        lengthen(size - 1, c);
       }
     };
     if (groups.next_member[g] < 0 && boundary == soup.degree(g)) {
@@ -334,6 +422,7 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
         add(c);
         // The next boundary corner: turn around the edge's end inside the group.
         int n = k.next[c];
+        if (group(k.twin[n]) == g) check_vertex[soup.vertex[n]] = 1;  // an edge inside g
         while (group(k.twin[n]) == g) {
           n = k.next[k.twin[n]];
           if (++steps > nc) return false;
@@ -346,11 +435,13 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
       if (walked != boundary) return false;
     }
     const int d = size - first;
-    if (before_first >= 0 && d > 0) chain_end[size - 1] = before_first;  // the chain wraps
+    if (before_first >= 0 && d > 0) lengthen(size - 1, before_first);  // the chain wraps
     if (d < 3) return false;
-    out.begin.push_back(size);
-    out.source.push_back(soup.source[largest[g]]);
+    out.source[polygons] = soup.source[largest[g]];
+    out.begin[++polygons] = size;
   }
+  out.begin.resize(polygons + 1);
+  out.source.resize(polygons);
   // Each polygon's corner test, against the plane of its group's largest facet (the group
   // of the corners its chains cover): independent, so in parallel, after the walks.
   std::atomic<bool> convex{true};
@@ -364,8 +455,11 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
   });
   if (!convex.load()) return false;
   out.vertex.resize(size);
-  merged_twin.resize(size);
-  for (int m = 0; m < size; ++m) merged_twin[m] = chain_of[k.twin[chain_end[m]]];
+  merged_twins.twin = Ints(size);
+  for (int m = 0; m < size; ++m) merged_twins.twin[m] = chain_of[k.twin[chain_end[m]]];
+  long_chain.resize(size);
+  merged_twins.check_corner = std::move(long_chain);
+  merged_twins.check_vertex = std::move(check_vertex);
   merged = std::move(out);
   return true;
 }
@@ -374,41 +468,49 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
 /// those `connect` would find (it then decides): each candidate must be the reverse edge,
 /// pairing must be mutual, and each vertex must have one fan with no two edges to one vertex.
 /// Then the soup is a closed, oriented 2-manifold whose reverse edges are unique, so
-/// `connect` would succeed with these twins.
-std::optional<Connectivity> connect_with(int num_points, const Soup& soup,
-                                         std::vector<int>&& twin) {
+/// `connect` would succeed with these twins. Only the corners and vertices that `merged`
+/// marks are checked: the others pass by construction (see MergedTwins).
+std::optional<Connectivity> connect_with(int num_points, const Soup& soup, MergedTwins&& merged) {
   const int nc = static_cast<int>(soup.vertex.size());
   Connectivity k = facet_cycles(soup);
-  k.twin = std::move(twin);
+  k.twin = std::move(merged.twin);
   std::atomic<bool> reverse{true};
   parallel_chunks(nc, kCornerGrain, [&](int first, int last) {
+    const int *vertex = soup.vertex.data(), *next = k.next.data(), *twin = k.twin.data();
+    const char* check = merged.check_corner.data();
     for (int c = first; c < last; ++c) {
-      const int t = k.twin[c];
-      if (t < 0 || t >= nc || t == c || k.twin[t] != c ||
-          soup.vertex[t] != soup.vertex[k.next[c]] || soup.vertex[k.next[t]] != soup.vertex[c]) {
+      if (!check[c]) continue;
+      const int t = twin[c];
+      if (t < 0 || t >= nc || t == c || twin[t] != c || vertex[t] != vertex[next[c]] ||
+          vertex[next[t]] != vertex[c]) {
         reverse.store(false, std::memory_order_relaxed);
         return;
       }
     }
   });
   if (!reverse.load()) return std::nullopt;
-  std::vector<int> out_count(num_points, 0), mark(num_points, -1);
-  for (int c = 0; c < nc; ++c) ++out_count[soup.vertex[c]];
+  std::vector<int> out_count(num_points, 0), marks(num_points, -1);
+  // Plain pointers: the writes through them could alias the arrays' own pointers.
+  const int *vertex = soup.vertex.data(), *next = k.next.data(), *prev = k.prev.data(),
+            *twins = k.twin.data();
+  int *count = out_count.data(), *mark = marks.data();
+  const char* check = merged.check_vertex.data();
+  for (int c = 0; c < nc; ++c) ++count[vertex[c]];
   for (int s = 0; s < nc; ++s) {
-    const int v = soup.vertex[s];
-    if (out_count[v] < 0) continue;  // its fan is checked
+    const int v = vertex[s];
+    if (!check[v] || count[v] < 0) continue;  // its fan needs no check, or is checked
     // Turning from an outgoing edge to the next is a permutation of the corners leaving v:
     // one fan when its orbit holds all of them.
     int c = s, steps = 0;
     do {
-      int& m = mark[soup.vertex[k.next[c]]];
+      int& m = mark[vertex[next[c]]];
       if (m == v) return std::nullopt;  // v -> w twice
       m = v;
-      c = k.twin[k.prev[c]];
+      c = twins[prev[c]];
       ++steps;
-    } while (c != s && steps <= out_count[v]);
-    if (steps != out_count[v] || c != s) return std::nullopt;
-    out_count[v] = -1;
+    } while (c != s && steps <= count[v]);
+    if (steps != count[v] || c != s) return std::nullopt;
+    count[v] = -1;
   }
   return k;
 }
@@ -421,16 +523,16 @@ std::optional<std::pair<Soup, Connectivity>> simplify(const std::vector<V3<doubl
   std::optional<Connectivity> k = connect(static_cast<int>(points.size()), soup);
   if (!k) return std::nullopt;
   Soup merged;
-  std::vector<int> merged_twin;
+  MergedTwins merged_twins;
   bool changed = false;
-  if (!merge_coplanar(points, soup, *k, limit, strict, merged, merged_twin, changed)) {
+  if (!merge_coplanar(points, soup, *k, limit, strict, merged, merged_twins, changed)) {
     if (strict) return std::nullopt;
     return std::make_pair(std::move(soup), std::move(*k));
   }
   if (!changed) return std::make_pair(std::move(soup), std::move(*k));
   if (strict) k.reset();  // no use for it any more: its memory serves the next one
   std::optional<Connectivity> km =
-      connect_with(static_cast<int>(points.size()), merged, std::move(merged_twin));
+      connect_with(static_cast<int>(points.size()), merged, std::move(merged_twins));
   if (!km) km = connect(static_cast<int>(points.size()), merged);
   if (km) return std::make_pair(std::move(merged), std::move(*km));
   if (strict) return std::nullopt;
@@ -443,47 +545,50 @@ std::optional<std::pair<Soup, Connectivity>> simplify(const std::vector<V3<doubl
 Mesh build(const std::vector<V3<double>>& points, const Soup& soup, const Connectivity& k) {
   Mesh mesh;
   const int nc = static_cast<int>(soup.vertex.size());
-  std::vector<Mesh::VertexHandle> handle(points.size());
-  std::vector<char> used(points.size(), 0);
-  for (int v : soup.vertex) used[v] = 1;
-  int num_used = 0;
-  for (std::size_t v = 0; v < points.size(); ++v)
-    if (used[v]) handle[v] = Mesh::VertexHandle(num_used++);
+  const int np = static_cast<int>(points.size());
+  std::vector<int> handle(np, -1);  // the mesh vertex of each point (-1: unused)
   int num_edges = 0;
-  for (int c = 0; c < nc; ++c) num_edges += k.twin[c] >= c;
+  for (int c = 0; c < nc; ++c) {
+    handle[soup.vertex[c]] = 0;
+    num_edges += k.twin[c] >= c;
+  }
+  int num_used = 0;
+  for (int v = 0; v < np; ++v)
+    if (handle[v] >= 0) handle[v] = num_used++;
   // Every element at once: OpenMesh grows each of its property arrays per added element.
   // The elements are numbered as add_vertex, new_edge and new_face would number them.
   mesh.resize(num_used, num_edges, soup.size());
   // The point array, looked up once (set_point looks its property up by a dynamic_cast).
   Point* point = mesh.property(mesh.points_pph()).data_vector().data();
-  for (std::size_t v = 0; v < points.size(); ++v)
-    if (used[v]) point[handle[v].idx()] = Point(points[v].x, points[v].y, points[v].z);
-  std::vector<Mesh::HalfedgeHandle> he(nc);
+  for (int v = 0; v < np; ++v)
+    if (handle[v] >= 0) point[handle[v]] = Point(points[v].x, points[v].y, points[v].z);
+  const auto vh = [&](int c) { return Mesh::VertexHandle(handle[soup.vertex[c]]); };
+  Ints halfedge(nc);  // of each corner
+  const auto he = [&](int c) { return Mesh::HalfedgeHandle(halfedge[c]); };
+  // One pass, face by face (the corners in order): a face's halfedges are all known after
+  // its own corners, as the twins of earlier corners or new edges.
   int edge = 0;
-  for (int c = 0; c < nc; ++c) {
-    const int t = k.twin[c];
-    if (t < c) {
-      he[c] = mesh.opposite_halfedge_handle(he[t]);
-    } else {
-      he[c] = mesh.halfedge_handle(Mesh::EdgeHandle(edge++), 0);
-      mesh.set_vertex_handle(he[c], handle[soup.vertex[k.next[c]]]);
-      mesh.set_vertex_handle(mesh.opposite_halfedge_handle(he[c]), handle[soup.vertex[c]]);
-    }
-  }
-  // Faces write their own halfedges only: in parallel.
-  parallel_chunks(soup.size(), kFacetGrain, [&](int first, int last) {
-    for (int f = first; f < last; ++f) {
-      const Mesh::FaceHandle fh(f);
-      const int b = soup.begin[f], e = soup.begin[f + 1];
-      for (int c = b; c < e; ++c) {
-        mesh.set_face_handle(he[c], fh);
-        mesh.set_next_halfedge_handle(he[c], he[k.next[c]]);
+  for (int f = 0; f < soup.size(); ++f) {
+    const int b = soup.begin[f], e = soup.begin[f + 1];
+    for (int c = b; c < e; ++c) {
+      const int t = k.twin[c];
+      if (t < c) {
+        halfedge[c] = mesh.opposite_halfedge_handle(he(t)).idx();
+      } else {
+        halfedge[c] = mesh.halfedge_handle(Mesh::EdgeHandle(edge++), 0).idx();
+        mesh.set_vertex_handle(he(c), vh(k.next[c]));
+        mesh.set_vertex_handle(mesh.opposite_halfedge_handle(he(c)), vh(c));
       }
-      mesh.set_halfedge_handle(fh, he[e - 1]);  // as add_face: the cycle starts at vertex b
+      // A vertex's halfedge is its last corner's (as when faces are added in order).
+      mesh.set_halfedge_handle(vh(c), he(c));
     }
-  });
-  // A vertex's halfedge is its last corner's (as when faces are added in order).
-  for (int c = 0; c < nc; ++c) mesh.set_halfedge_handle(handle[soup.vertex[c]], he[c]);
+    const Mesh::FaceHandle fh(f);
+    for (int c = b; c < e; ++c) {
+      mesh.set_face_handle(he(c), fh);
+      mesh.set_next_halfedge_handle(he(c), he(k.next[c]));
+    }
+    mesh.set_halfedge_handle(fh, he(e - 1));  // as add_face: the cycle starts at vertex b
+  }
   return mesh;
 }
 
@@ -596,7 +701,7 @@ Soup hull_facets(const std::vector<V3<double>>& points, const Soup& facets) {
 }  // namespace
 
 Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& face_begin,
-                const std::vector<int>& corners, std::vector<int>* source) {
+                std::vector<int> corners, std::vector<int>* source) {
   constexpr int kPairwiseDegree = 16;  // facets up to this degree are checked corner by corner
   const int n = static_cast<int>(points.size());
   const int nf = static_cast<int>(face_begin.size()) - 1;
@@ -632,13 +737,16 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
     }
   };
   // The facets with close corners (few), found in parallel; their unions follow in order.
+  // A corner repeated in a facet compared pair by pair marks it too (it is close to itself
+  // unless its point is not finite): the facets are then not the soup as they are, and the
+  // unions below are those of close corners either way.
   std::vector<char> has_close(nf, 0);
   std::atomic<bool> any_close{false};
   parallel_chunks(nf, kFacetGrain, [&](int first, int last) {
     bool found = false;
     for (int f = first; f < last; ++f) {
       bool here = false;
-      for_pairs(f, [&](int u, int w) { here = here || close(u, w); });
+      for_pairs(f, [&](int u, int w) { here = here || u == w || close(u, w); });
       has_close[f] = here;
       found = found || here;
     }
@@ -652,13 +760,16 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
         });
   Soup soup;
   bool repeated = false;
-  std::vector<int> last_facet(n, -1);  // the last facet a point was seen in, to find repeats
+  std::vector<int> last_facet;  // the last facet a point was seen in, to find repeats
   // Nothing merged (the usual case): the facets are the soup as they are, unless one has a
-  // repeated corner or fewer than three.
+  // repeated corner or fewer than three. Only a facet compared by its sides alone can still
+  // have one (the others would have been marked above).
   bool as_given = !any_close.load();
   for (int f = 0; f < nf && as_given; ++f) {
     const int b = face_begin[f], e = face_begin[f + 1];
     as_given = e - b >= 3;
+    if (e - b <= kPairwiseDegree) continue;
+    if (last_facet.empty()) last_facet.assign(n, -1);
     for (int c = b; c < e && as_given; ++c) {
       as_given = last_facet[corners[c]] != f;
       last_facet[corners[c]] = f;
@@ -666,11 +777,11 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
   }
   if (as_given) {
     soup.begin = face_begin;
-    soup.vertex = corners;
+    soup.vertex = std::move(corners);
     soup.source.resize(nf);
     std::iota(soup.source.begin(), soup.source.end(), 0);
   } else {
-    std::fill(last_facet.begin(), last_facet.end(), -1);
+    last_facet.assign(n, -1);
     soup.vertex.reserve(corners.size());
     soup.source.reserve(nf);
     std::vector<int> cycle;

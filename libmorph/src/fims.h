@@ -54,7 +54,8 @@ inline constexpr double kFeatureTolerance = 1e-11;
 /// points (exact predicates on the doubles) is grouped the same way instead. Linear in
 /// the result's size except in that fallback. `source` (optional) receives, per output
 /// face, its facet index (of its largest member when facets merged; -1 for none).
+/// `corners` by value: when nothing merges they become the mesh's facets as they are.
 Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& face_begin,
-                const std::vector<int>& corners, std::vector<int>* source);
+                std::vector<int> corners, std::vector<int>* source);
 
 }  // namespace morph::detail

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <initializer_list>
+#include <memory>
 #include <numeric>
 
 #include "fims.h"
@@ -380,33 +381,43 @@ namespace {
 void index_vertices(const SumFacets& facets, int num_a, int num_b,
                     std::vector<std::uint64_t>& pairs, std::vector<int>& corners) {
   const int nc = static_cast<int>(facets.corners.size());
-  // first[i]..first[i + 1]: the corners at vertex i of A, in `by_a`.
-  std::vector<int> first(num_a + 1, 0), by_a(nc);
+  // first[i]..first[i + 1]: the corners at vertex i of A, in `by_a`, with their vertex of B
+  // in `partner` (read in order below rather than through by_a).
+  std::vector<int> first(num_a + 1, 0);
+  const auto by_a = std::make_unique_for_overwrite<int[]>(nc);
+  const auto partner = std::make_unique_for_overwrite<int[]>(nc);
   for (const std::uint64_t key : facets.corners) ++first[pair_first(key)];
   std::partial_sum(first.begin(), first.end(), first.begin());  // first[i]: end of bucket i
-  for (int c = nc - 1; c >= 0; --c) by_a[--first[pair_first(facets.corners[c])]] = c;
+  for (int c = nc - 1; c >= 0; --c) {
+    const std::uint64_t key = facets.corners[c];
+    const int k = --first[pair_first(key)];
+    by_a[k] = c;
+    partner[k] = pair_second(key);
+  }
   std::vector<int> slot(num_b, -1);  // pair index of (i, j) while bucket i is numbered
-  std::vector<int> partners;
-  pairs.clear();
+  const auto partners = std::make_unique_for_overwrite<int[]>(num_b);  // of bucket i, distinct
+  // At most one pair per corner: filled up to `size` (push_back is not inlined), then copied.
+  const auto found = std::make_unique_for_overwrite<std::uint64_t[]>(nc);
   corners.resize(nc);
+  int size = 0;
   for (int i = 0; i < num_a; ++i) {
-    partners.clear();
+    int n = 0;
     for (int k = first[i]; k < first[i + 1]; ++k) {
-      const int j = pair_second(facets.corners[by_a[k]]);
+      const int j = partner[k];
       if (slot[j] < 0) {
         slot[j] = 0;
-        partners.push_back(j);
+        partners[n++] = j;
       }
     }
-    std::sort(partners.begin(), partners.end());
-    for (const int j : partners) {
-      slot[j] = static_cast<int>(pairs.size());
-      pairs.push_back(pair_key(i, j));
+    std::sort(partners.get(), partners.get() + n);
+    for (int p = 0; p < n; ++p) {
+      slot[partners[p]] = size;
+      found[size++] = pair_key(i, partners[p]);
     }
-    for (int k = first[i]; k < first[i + 1]; ++k)
-      corners[by_a[k]] = slot[pair_second(facets.corners[by_a[k]])];
-    for (const int j : partners) slot[j] = -1;
+    for (int k = first[i]; k < first[i + 1]; ++k) corners[by_a[k]] = slot[partner[k]];
+    for (int p = 0; p < n; ++p) slot[partners[p]] = -1;
   }
+  pairs.assign(found.get(), found.get() + size);
 }
 
 /// A vertex of a polytope in homogeneous dyadic coordinates (X, W) with an estimate of X / W.
@@ -489,7 +500,7 @@ LabelledMesh sum_mesh(const Polytope& A, const Polytope& B, const SumFacets& fac
   });
   std::vector<int> source;
   // Initialised in place: OpenMesh meshes have no move assignment, only a deep copy.
-  LabelledMesh out{clean_mesh(points, facets.face_begin, corners, &source), {}};
+  LabelledMesh out{clean_mesh(points, facets.face_begin, std::move(corners), &source), {}};
   // A face with no source (a triangle of the hull fallback that no facet owns) has no origin.
   out.origins.reserve(source.size());
   for (int f : source)
