@@ -466,6 +466,15 @@ TEST_CASE("halfspace_intersection: an erosion by a small element is guessed from
   }
 }
 
+// The element of the random erosion and opening tests: an integer polytope (parallel
+// facets) every third seed, else a random polytope of 11 to 22 vertices.
+namespace {
+morph::Mesh random_element(std::uint64_t seed) {
+  return seed % 3 == 0 ? morph::test::random_integer_polytope(8, seed, 2)
+                       : morph::test::random_sphere_polytope(10 + static_cast<int>(seed), seed + 50);
+}
+}  // namespace
+
 // Random polytopes and elements of several sizes: whether the guess is taken or not (a
 // facet of A vanishes, an edge collapses), the result is the hull's and the exact route's.
 TEST_CASE("halfspace_intersection: erosions of random polytopes, guessed or not") {
@@ -475,9 +484,7 @@ TEST_CASE("halfspace_intersection: erosions of random polytopes, guessed or not"
       CAPTURE(seed);
       CAPTURE(size);
       const Polytope A = make_operand(morph::test::random_sphere_polytope(60, seed), "A");
-      const morph::Mesh B = seed % 3 == 0 ? morph::test::random_integer_polytope(8, seed, 2)
-                                          : morph::test::random_sphere_polytope(
-                                                10 + static_cast<int>(seed), seed + 50);
+      const morph::Mesh B = random_element(seed);
       const MaybePolytope r = eroded_three_ways(A, make_operand(morph::test::scaled(B, size), "B"));
       (r.route == HullRoute::expected ? guessed : rejected)++;
     }
@@ -954,9 +961,7 @@ TEST_CASE("halfspace_intersection: openings with exact points on demand are the 
       CAPTURE(seed);
       CAPTURE(size);
       const Polytope A = make_operand(morph::test::random_sphere_polytope(60, seed), "A");
-      const morph::Mesh B = seed % 3 == 0 ? morph::test::random_integer_polytope(8, seed, 2)
-                                          : morph::test::random_sphere_polytope(
-                                                10 + static_cast<int>(seed), seed + 50);
+      const morph::Mesh B = random_element(seed);
       check_opening_routes(A, make_operand(morph::test::scaled(B, size), "B"));
     }
   }

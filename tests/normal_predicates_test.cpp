@@ -85,6 +85,16 @@ Mesh shifted(Mesh mesh, double t) {
   return mesh;
 }
 
+// A's facets in `order`, the three whose unit normals are closest to n first.
+template <class V>
+void closest_three(const Polytope& A, const V& n, std::vector<int>& order) {
+  std::iota(order.begin(), order.end(), 0);
+  std::partial_sort(order.begin(), order.begin() + 3, order.end(), [&](int f, int g) {
+    const auto &u = A.unit_normals[f], &w = A.unit_normals[g];
+    return n.x * u.x + n.y * u.y + n.z * u.z > n.x * w.x + n.y * w.y + n.z * w.z;
+  });
+}
+
 }  // namespace
 
 TEST_CASE(
@@ -167,12 +177,7 @@ TEST_CASE("normal predicates: orientation against an arc's plane agrees with exa
       const NormalRef l{&B, B.edges[e].left}, r{&B, B.edges[e].right};
       // A's facets with the normals closest to the arc's ends.
       for (const NormalRef& end : {l, r}) {
-        const auto& n = end.unit();
-        std::iota(order.begin(), order.end(), 0);
-        std::partial_sort(order.begin(), order.begin() + 3, order.end(), [&](int f, int g) {
-          const auto &u = A.unit_normals[f], &w = A.unit_normals[g];
-          return n.x * u.x + n.y * u.y + n.z * u.z > n.x * w.x + n.y * w.y + n.z * w.z;
-        });
+        closest_three(A, end.unit(), order);
         for (int k = 0; k < 3; ++k) {
           const NormalRef x{&A, order[k]};
           const int exact = CGAL::sign(morph::detail::det(l.exact(), r.exact(), x.exact()));
@@ -213,12 +218,7 @@ TEST_CASE("normal predicates: a region's slot planes agree with exact evaluation
         const int s = begin + i;
         const NormalRef l{&B, B.fan_face[s]}, r{&B, B.fan_face[begin + (i + 1) % n]};
         flipped += B.edges[B.fan_edge[s]].left != l.face;
-        const auto& m = l.unit();
-        std::iota(order.begin(), order.end(), 0);
-        std::partial_sort(order.begin(), order.begin() + 3, order.end(), [&](int f, int g) {
-          const auto &u = A.unit_normals[f], &w = A.unit_normals[g];
-          return m.x * u.x + m.y * u.y + m.z * u.z > m.x * w.x + m.y * w.y + m.z * w.z;
-        });
+        closest_three(A, l.unit(), order);
         for (int k = 0; k < 3; ++k) {
           const NormalRef x{&A, order[k]};
           const int exact = CGAL::sign(morph::detail::det(l.exact(), r.exact(), x.exact()));

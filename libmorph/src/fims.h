@@ -29,6 +29,13 @@ inline int pair_second(std::uint64_t k) { return static_cast<int>(k & 0xffffffff
 /// Computes the facets of A (+) B. Runs in the calling TBB arena.
 SumFacets fims_facets(const Polytope& A, const Polytope& B);
 
+/// The vertices of A (+) B as its facets use them: the distinct pairs (i, j), sorted, and
+/// each corner's index among them (sum_mesh and sum_polytope number S's vertices so).
+/// Linear in the number of corners: a counting sort buckets the corners by their vertex of
+/// A, and in each bucket only the few distinct partners in B are sorted.
+void index_vertices(const SumFacets& facets, int num_a, int num_b,
+                    std::vector<std::uint64_t>& pairs, std::vector<int>& corners);
+
 /// The rounded result as a mesh: vertex i + j at the correctly rounded sum. Vertices
 /// that round to the same point are merged (see docs/algorithm.md, "below double
 /// precision"); facets left with fewer than three vertices are dropped.

@@ -1955,40 +1955,6 @@ ErosionInput erode_sum_input(const Polytope& S, const Polytope& A, const Polytop
 
 namespace {
 
-/// The vertices of a sum numbered as sum_polytope numbers them (index_vertices,
-/// minkowski_sum.cpp): the distinct pairs sorted, and each corner's index among them. A
-/// counting sort by the vertex of A, then the few partners in B of each sorted.
-void number_pairs(const SumFacets& facets, int num_a, int num_b, std::vector<std::uint64_t>& pairs,
-                  std::vector<int>& corners) {
-  const int nc = static_cast<int>(facets.corners.size());
-  std::vector<int> first(num_a + 1, 0), by_a(nc);
-  for (const std::uint64_t key : facets.corners) ++first[pair_first(key)];
-  std::partial_sum(first.begin(), first.end(), first.begin());
-  for (int c = nc - 1; c >= 0; --c) by_a[--first[pair_first(facets.corners[c])]] = c;
-  std::vector<int> slot(num_b, -1);
-  std::vector<int> partners;
-  pairs.clear();
-  corners.resize(nc);
-  for (int i = 0; i < num_a; ++i) {
-    partners.clear();
-    for (int k = first[i]; k < first[i + 1]; ++k) {
-      const int j = pair_second(facets.corners[by_a[k]]);
-      if (slot[j] < 0) {
-        slot[j] = 0;
-        partners.push_back(j);
-      }
-    }
-    std::sort(partners.begin(), partners.end());
-    for (const int j : partners) {
-      slot[j] = static_cast<int>(pairs.size());
-      pairs.push_back(pair_key(i, j));
-    }
-    for (int k = first[i]; k < first[i + 1]; ++k)
-      corners[by_a[k]] = slot[pair_second(facets.corners[by_a[k]])];
-    for (const int j : partners) slot[j] = -1;
-  }
-}
-
 /// Whether facet f of P (double points) is exactly planar; its exact Newell normal into
 /// `normal` (when not null) if it is. A triangle is, and its normal is (q - p) x (r - p), the
 /// same value.
@@ -2165,7 +2131,7 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
   // plane.
   std::vector<std::uint64_t> pairs;
   std::vector<int> corner_vertex;
-  number_pairs(sum, A.num_vertices(), B.num_vertices(), pairs, corner_vertex);
+  index_vertices(sum, A.num_vertices(), B.num_vertices(), pairs, corner_vertex);
   const std::vector<char> on_plane(corner_vertex.size(), 1);
   const auto pair_of = [&](int v) { return pairs[v]; };
   const auto point_of = [&](int v, int b, KnownPoints& known, int k) {

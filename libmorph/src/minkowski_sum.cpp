@@ -373,11 +373,6 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
   return gather({&translated, &corner, &edge});
 }
 
-namespace {
-
-/// The distinct vertex pairs of the facets, sorted, and each corner's index among them.
-/// Linear in the number of corners: a counting sort buckets the corners by their vertex
-/// of A, and in each bucket only the few distinct partners in B are sorted.
 void index_vertices(const SumFacets& facets, int num_a, int num_b,
                     std::vector<std::uint64_t>& pairs, std::vector<int>& corners) {
   const int nc = static_cast<int>(facets.corners.size());
@@ -419,6 +414,8 @@ void index_vertices(const SumFacets& facets, int num_a, int num_b,
   }
   pairs.assign(found.get(), found.get() + size);
 }
+
+namespace {
 
 /// A vertex of a polytope in homogeneous dyadic coordinates (X, W) with an estimate of X / W.
 struct Homogeneous {
