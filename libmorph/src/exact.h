@@ -159,6 +159,10 @@ inline V3<Interval> to_interval(const V3<Exact>& p) {
   return {Interval(CGAL::to_interval(p.x)), Interval(CGAL::to_interval(p.y)),
           Interval(CGAL::to_interval(p.z))};
 }
+inline Interval to_interval_n(const ExactN& x) { return Interval(x.to_interval()); }
+inline V3<Interval> to_interval_n(const V3<ExactN>& p) {
+  return {to_interval_n(p.x), to_interval_n(p.y), to_interval_n(p.z)};
+}
 
 /// Rounds an exact rational to the nearest double (ties to even).
 double round_to_nearest(const Exact& q);
