@@ -331,13 +331,6 @@ bool same_cycle(const Polytope& P, int f, int d, const VertexAt& vertex_at) {
   return true;
 }
 
-/// The edge of P from u to w (either direction), or -1.
-int edge_between(const Polytope& P, int u, int w) {
-  for (int s = P.fan_begin[u]; s < P.fan_begin[u + 1]; ++s)
-    if (P.fan_vertex[s] == w) return P.fan_edge[s];
-  return -1;
-}
-
 }  // namespace
 
 MaybePolytope erode_sum(const SumFacets& sum, const Polytope& A, const Polytope& B,
@@ -378,7 +371,7 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
         found = planar_normal(A, g, &h.normal);
         b = j_at(0);
       } else if (one_i) {
-        const int e = d >= 3 ? edge_between(B, j_at(0), j_at(1)) : -1;
+        const int e = d >= 3 ? B.edge_between(j_at(0), j_at(1)) : -1;
         const int f = e < 0 ? -1 : B.edges[e].from == j_at(0) ? B.edges[e].left : B.edges[e].right;
         if (same_cycle(B, f, d, j_at)) {
           simple = true;
@@ -400,7 +393,7 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
             side[k] = moves_a ? exact_difference(A.points[i_at(l)], A.points[i_at(k)])
                               : exact_difference(B.points[j_at(l)], B.points[j_at(k)]);
         }
-        const int e = parallelogram ? edge_between(B, j_at(0), j_at(2)) : -1;
+        const int e = parallelogram ? B.edge_between(j_at(0), j_at(2)) : -1;
         if (e >= 0) {
           simple = true;
           const V3<ExactN> m = cross(side[0], side[1]);
@@ -427,7 +420,7 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
         if (js.size() == 1) {
           b = js[0];
         } else if (js.size() == 2) {
-          const int e = edge_between(B, js[0], js[1]);
+          const int e = B.edge_between(js[0], js[1]);
           known_face = known_face && e >= 0;
           if (e >= 0) {
             b = B.edges[e].from;

@@ -157,21 +157,16 @@ void edge_facets(const Polytope& A, int a, const ArcPlane& plane_a, const Polyto
       side_of_b = s2;  // as arc_contact gives it
       return true;
     };
-    auto edge_between = [&](int v, int u) {
-      for (int s = B.fan_begin[v]; s < B.fan_begin[v + 1]; ++s)
-        if (B.fan_vertex[s] == u) return B.fan_edge[s];
-      return -1;
-    };
     const int l = start.index, r = end.index;
     int side1, side2;
-    if (const int e = edge_between(l, r); e >= 0) {
+    if (const int e = B.edge_between(l, r); e >= 0) {
       if (crosses(e, side1)) {
         emit(e, side1);
         return;
       }
     } else {
       for (int s = B.fan_begin[l]; s < B.fan_begin[l + 1]; ++s) {
-        const int e2 = edge_between(B.fan_vertex[s], r);
+        const int e2 = B.edge_between(B.fan_vertex[s], r);
         if (e2 < 0) continue;
         const int e1 = B.fan_edge[s];
         if (crosses(e1, side1) && crosses(e2, side2)) {  // in B's edge order

@@ -153,6 +153,12 @@ struct Polytope {
   int num_edges() const { return static_cast<int>(edges.size()); }
   int degree(int f) const { return face_begin[f + 1] - face_begin[f]; }
   int corner(int f, int k) const { return corner_vertex[face_begin[f] + k]; }
+  /// The edge between vertices u and w (either direction), or -1: a scan of u's fan.
+  int edge_between(int u, int w) const {
+    for (int s = fan_begin[u]; s < fan_begin[u + 1]; ++s)
+      if (fan_vertex[s] == w) return fan_edge[s];
+    return -1;
+  }
 
   V3<Exact> exact_point(int v) const {
     return exact_points.empty() ? to_exact(points[v]) : exact_points.rational(v);
