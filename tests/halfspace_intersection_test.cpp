@@ -117,10 +117,60 @@ const morph::Mesh& sample(const std::string& name) {
   return it->second;
 }
 
+/// First difference between two polytopes in any field (positions, exact points, normals,
+/// connectivity, labels), or "".
+std::string polytope_difference(const Polytope& a, const Polytope& b) {
+  if (a.num_vertices() != b.num_vertices()) return "vertex counts differ";
+  for (int v = 0; v < a.num_vertices(); ++v) {
+    const V3<double>&p = a.points[v], &q = b.points[v];
+    if (p.x != q.x || p.y != q.y || p.z != q.z) return "point " + std::to_string(v) + " differs";
+    if (a.exact_points.empty() != b.exact_points.empty()) return "exactness differs";
+    if (a.exact_points.empty()) continue;
+    const V3<ExactN>&x = a.exact_points.X(v), &y = b.exact_points.X(v);
+    if (x.x != y.x || x.y != y.y || x.z != y.z || a.exact_points.W(v) != b.exact_points.W(v))
+      return "exact point " + std::to_string(v) + " differs";
+  }
+  if (a.given_normals.size() != b.given_normals.size()) return "given normal counts differ";
+  for (std::size_t f = 0; f < a.given_normals.size(); ++f) {
+    const V3<ExactN>&m = a.given_normals[f], &n = b.given_normals[f];
+    if (m.x != n.x || m.y != n.y || m.z != n.z) return "normal " + std::to_string(f) + " differs";
+  }
+  if (a.face_begin != b.face_begin || a.corner_vertex != b.corner_vertex) return "facets differ";
+  if (a.corner_edge != b.corner_edge) return "corner edges differ";
+  if (a.num_edges() != b.num_edges()) return "edge counts differ";
+  for (int e = 0; e < a.num_edges(); ++e) {
+    const Polytope::Edge &x = a.edges[e], &y = b.edges[e];
+    if (x.from != y.from || x.to != y.to || x.left != y.left || x.right != y.right)
+      return "edge " + std::to_string(e) + " differs";
+  }
+  if (a.fan_begin != b.fan_begin || a.fan_face != b.fan_face || a.fan_edge != b.fan_edge ||
+      a.fan_vertex != b.fan_vertex)
+    return "fans differ";
+  for (int f = 0; f < a.num_faces(); ++f) {
+    const UnitNormal &m = a.unit_normals[f], &n = b.unit_normals[f];
+    if (m.x != n.x || m.y != n.y || m.z != n.z || m.error != n.error)
+      return "unit normal " + std::to_string(f) + " differs";
+  }
+  if (a.face_source != b.face_source || a.vertex_source != b.vertex_source ||
+      a.edge_source != b.edge_source || a.sum_pairs != b.sum_pairs)
+    return "labels differ";
+  return "";
+}
+
+/// The eroded polytope built straight from the verified intersection is make_polytope's
+/// (general build, merge pass, checks), field by field.
+void check_direct_polytope(const Polytope& A, const Polytope& B, const MaybePolytope& direct) {
+  const MaybePolytope general = erode_polytope(A, B, {.direct_polytope = false});
+  REQUIRE(direct.reason == general.reason);
+  if (direct.polytope) CHECK(polytope_difference(*direct.polytope, *general.polytope) == "");
+}
+
 /// A (-) B by erode_polytope's guess (A's vertices), by the incremental hull alone and by
-/// the exact route: exactly the same result. Returns the first.
+/// the exact route: exactly the same result, and its polytope built directly is
+/// make_polytope's. Returns the first.
 MaybePolytope eroded_three_ways(const Polytope& A, const Polytope& B) {
   const MaybePolytope guessed = erode_polytope(A, B);
+  check_direct_polytope(A, B, guessed);
   const MaybePolytope hull = erode_polytope(A, B, {.guess = false});
   const MaybePolytope exact = erode_polytope(A, B, {.incremental = false});
   CHECK(hull.route != HullRoute::expected);
@@ -894,6 +944,7 @@ void check_opening_routes(const Polytope& A, const Polytope& B) {
   CHECK(mesh_difference(sum_mesh(undecided, B, fims_facets(undecided, B)), want) == "");
   CHECK(difference(lazy, eager) == "");  // reads every exact point on demand
   CHECK(rounded_from_exact(lazy));
+  check_direct_polytope(A, B, lazy);
 }
 
 }  // namespace

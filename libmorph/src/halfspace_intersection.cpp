@@ -693,14 +693,97 @@ void sort_unique_lists(std::vector<int>& begin, std::vector<int>& list) {
   list.resize(kept);
 }
 
+/// The polytope of a verified intersection straight from its facet cycles (canonical
+/// numbering, counter-clockwise), each facet with its half-space's normal: what
+/// make_polytope builds from them, without its hash map, merge pass and checks. Those
+/// could not act: the intersection is exact, its facets lie on distinct planes, each edge
+/// joins two of them (strictly convex: the planes of a convex polytope's two facets along
+/// an edge are not the same) and each vertex has three facets or more, so nothing merges
+/// and the Gauss map is valid. The numbering is build_connectivity's: edges in the order
+/// of their first corner, each fan from its vertex's last corner.
+Polytope verified_polytope(std::vector<V3<double>> points, ExactPoints exact,
+                           std::vector<int> face_begin, std::vector<int> corner_vertex,
+                           std::vector<V3<ExactN>> normals) {
+  Polytope p;
+  p.points = std::move(points);
+  p.exact_points = std::move(exact);
+  p.given_normals = std::move(normals);
+  p.face_begin = std::move(face_begin);
+  p.corner_vertex = std::move(corner_vertex);
+  const int nv = p.num_vertices(), nf = p.num_faces();
+  const std::vector<int>& cv = p.corner_vertex;
+  const int nc = static_cast<int>(cv.size());
+  std::vector<int> corner_face(nc), next(nc), prev(nc);
+  for (int f = 0; f < nf; ++f) {
+    const int first = p.face_begin[f], last = p.face_begin[f + 1] - 1;
+    for (int c = first; c <= last; ++c) {
+      corner_face[c] = f;
+      next[c] = c == last ? first : c + 1;
+      prev[c] = c == first ? last : c - 1;
+    }
+  }
+  // Corners by their vertex, in increasing order (a counting sort): the corner of the
+  // directed edge u -> w is the one of u's whose next corner is at w.
+  std::vector<int> out_begin(nv + 1, 0), out(nc);
+  for (int c = 0; c < nc; ++c) ++out_begin[cv[c] + 1];
+  std::partial_sum(out_begin.begin(), out_begin.end(), out_begin.begin());
+  {
+    std::vector<int> slot(out_begin.begin(), out_begin.end() - 1);
+    for (int c = 0; c < nc; ++c) out[slot[cv[c]]++] = c;
+  }
+  const auto corner_of = [&](int u, int w) {
+    for (int j = out_begin[u]; j < out_begin[u + 1]; ++j)
+      if (cv[next[out[j]]] == w) return out[j];
+    throw error("internal error: an intersection's facets do not close up");
+  };
+  p.corner_edge.assign(nc, -1);
+  p.edges.reserve(nc / 2);
+  for (int c = 0; c < nc; ++c) {
+    if (p.corner_edge[c] >= 0) continue;
+    const int u = cv[c], w = cv[next[c]];
+    const int twin = corner_of(w, u);
+    p.corner_edge[c] = p.corner_edge[twin] = p.num_edges();
+    p.edges.push_back({u, w, corner_face[c], corner_face[twin]});
+  }
+  // Fans: from facet f at v, the next facet counter-clockwise holds v -> u for the corner
+  // u before v in f.
+  p.fan_begin.resize(nv + 1);
+  p.fan_face.reserve(nc);
+  p.fan_edge.reserve(nc);
+  p.fan_vertex.reserve(nc);
+  for (int v = 0; v < nv; ++v) {
+    p.fan_begin[v] = static_cast<int>(p.fan_face.size());
+    if (out_begin[v] == out_begin[v + 1]) continue;
+    const int start = out[out_begin[v + 1] - 1];
+    int c = start;
+    do {
+      const int u = cv[prev[c]];
+      p.fan_face.push_back(corner_face[c]);
+      p.fan_edge.push_back(p.corner_edge[prev[c]]);
+      p.fan_vertex.push_back(u);
+      c = corner_of(v, u);
+    } while (c != start);
+  }
+  p.fan_begin[nv] = static_cast<int>(p.fan_face.size());
+  p.compute_normals();
+  p.vertex_source.resize(nv);
+  std::iota(p.vertex_source.begin(), p.vertex_source.end(), 0);
+  p.face_source.resize(nf);
+  std::iota(p.face_source.begin(), p.face_source.end(), 0);
+  p.edge_source.resize(p.num_edges());
+  std::iota(p.edge_source.begin(), p.edge_source.end(), 0);
+  return p;
+}
+
 /// Builds the intersection from a candidate dual hull, checking exactly that it is the
 /// dual hull of all the planes; nullopt when it is not. The result has `rounded`, and
-/// `polytope` when `with_polytope` (its exact points computed up front when `eager_exact`,
-/// else on demand: polytope_points).
+/// `polytope` when options.polytope (its exact points computed up front when
+/// options.eager_exact, else on demand: polytope_points).
 std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
                                             const std::vector<Plane>& planes,
                                             const KnownPoints& known, DualSurface s,
-                                            bool with_polytope, bool eager_exact) {
+                                            const IntersectOptions& options) {
+  const bool with_polytope = options.polytope;
   const int nt = static_cast<int>(s.corner.size());
   const int n = static_cast<int>(planes.size());
   if (nt == 0) return std::nullopt;
@@ -1088,21 +1171,26 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     rp.face_source[f] = hs[face_halfspace[f]].source;
     rp.face_element[f] = hs[face_halfspace[f]].element;
   }
-  std::vector<std::vector<int>> faces;  // for a polytope
-  if (with_polytope)
-    for (int f = 0; f < nf; ++f)
-      faces.emplace_back(face_vertex.begin() + face_begin[f],
-                         face_vertex.begin() + face_begin[f + 1]);
-  rp.face_begin = std::move(face_begin);
-  rp.corner_vertex = std::move(face_vertex);
   if (with_polytope) {
-    std::vector<V3<ExactN>> normals(faces.size());
-    for (std::size_t f = 0; f < faces.size(); ++f) normals[f] = hs[face_halfspace[f]].normal;
-    Polytope p = make_polytope(rp.points, polytope_points(planes, vertex, order, eager_exact),
-                               faces, std::move(normals), "A (-) B");
+    std::vector<V3<ExactN>> normals(nf);
+    for (int f = 0; f < nf; ++f) normals[f] = hs[face_halfspace[f]].normal;
+    ExactPoints points = polytope_points(planes, vertex, order, options.eager_exact);
+    Polytope p;
+    if (options.direct_polytope) {
+      p = verified_polytope(rp.points, std::move(points), face_begin, face_vertex,
+                            std::move(normals));
+    } else {
+      std::vector<std::vector<int>> faces;
+      for (int f = 0; f < nf; ++f)
+        faces.emplace_back(face_vertex.begin() + face_begin[f],
+                           face_vertex.begin() + face_begin[f + 1]);
+      p = make_polytope(rp.points, std::move(points), faces, std::move(normals), "A (-) B");
+    }
     for (auto& src : p.face_source) src = hs[face_halfspace[src]].source;
     out.polytope = std::move(p);
   }
+  rp.face_begin = std::move(face_begin);
+  rp.corner_vertex = std::move(face_vertex);
   return out;
 }
 
@@ -1639,8 +1727,8 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
   // The verification does not depend on o: any exact interior point (there is one) makes
   // the duality argument hold, so the rounded o only has to centre the virtual planes.
   if (options.incremental && options.guess && !expected.empty()) {
-    if (auto built = build_verified(hs, planes, known, expected_surface(planes, known, expected),
-                                    options.polytope, options.eager_exact)) {
+    if (auto built =
+            build_verified(hs, planes, known, expected_surface(planes, known, expected), options)) {
       built->route = HullRoute::expected;
       return std::move(*built);
     }
@@ -1652,8 +1740,7 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
       const auto outcome = IncrementalHull(planes, known, o_double, reach).run(s);
       if (outcome == IncrementalHull::Outcome::too_small) continue;
       if (outcome == IncrementalHull::Outcome::hull) {
-        if (auto built = build_verified(hs, planes, known, std::move(s), options.polytope,
-                                        options.eager_exact)) {
+        if (auto built = build_verified(hs, planes, known, std::move(s), options)) {
           built->route = HullRoute::incremental;
           return std::move(*built);
         }
@@ -1661,8 +1748,7 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
       break;
     }
   }
-  auto built = build_verified(hs, planes, known, exact_dual_hull(planes, o), options.polytope,
-                              options.eager_exact);
+  auto built = build_verified(hs, planes, known, exact_dual_hull(planes, o), options);
   if (!built) throw error("internal error: the exact dual hull of an erosion failed its own check");
   built->route = HullRoute::exact;
   return std::move(*built);

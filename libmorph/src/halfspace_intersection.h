@@ -66,6 +66,9 @@ struct IntersectOptions {
   // true: the polytope's exact points are all computed up front and it has no precise points
   // (its sums are then rounded exactly; tests compare the routes). false: on demand.
   bool eager_exact = false;
+  // true: the polytope is built straight from the verified facet cycles (verified_polytope).
+  // false: through make_polytope's general build, merge pass and checks (tests compare).
+  bool direct_polytope = true;
 };
 
 /// Points known to lie exactly on some of the half-spaces' planes: an erosion knows them
