@@ -487,6 +487,14 @@ TEST_CASE("halfspace_intersection: a closing from the sum's facets, without the 
     CHECK(via_sum.route == via_s.route);
     CHECK(rounded_from_exact(via_sum));
     CHECK(via_sum.rounded.face_element == via_s.rounded.face_element);
+    if (!got) continue;
+    // The check's walks over S's facets that are not A's start at their known points and
+    // read incidences from them: the same result as by arithmetic alone (no known points,
+    // so no guess: the incremental hull).
+    const MaybePolytope plain = intersect_halfspaces(got->halfspaces, got->hint, {}, {}, {});
+    CHECK(plain.route == HullRoute::incremental);
+    CHECK(difference(plain, via_sum) == "");
+    CHECK(plain.rounded.face_element == via_sum.rounded.face_element);
   }
 }
 

@@ -243,6 +243,25 @@ HVertex vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& ab
   return v;
 }
 
+/// The vertex of three planes whose normals are known to be independent (det > 0, checked
+/// exactly): a known point on all three is taken as it is, without the meet's intervals
+/// (vertex_of needs those only to tell the normals independent).
+HVertex independent_vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& abc,
+                              const KnownPoints& known) {
+  const int k = known.empty() ? -1 : known.common(abc[0], abc[1], abc[2]);
+  if (k < 0) return vertex_of(planes, abc, known);
+  HVertex v;
+  v.planes = abc;
+  v.known = k;
+  v.Xi = known.Xi[k];
+  v.Wi = known.Wi[k];
+  v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
+  v.X = known.X[k];
+  v.W = known.W[k];
+  v.has_exact = true;
+  return v;
+}
+
 /// Whether plane i is known to pass through vertex v (no arithmetic).
 bool known_through(const KnownPoints& known, int i, const HVertex& v) {
   return v.known >= 0 && known.passes(i, v.known);
@@ -838,7 +857,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     HVertex local;
     for (int t = begin; t < end && ok; ++t) {
       HVertex& v = stored ? s.vertex[t] : local;
-      if (!stored || !s.has_vertex[t]) v = vertex_of(planes, s.corner[t], known);
+      if (!stored || !s.has_vertex[t]) v = independent_vertex_of(planes, s.corner[t], known);
       for (int k = 0; k < 3; ++k) {
         const auto& cn = s.corner[s.across[t][k]];
         const int a = s.corner[t][k], b = s.corner[t][(k + 1) % 3];
@@ -893,7 +912,8 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     vertex.resize(nv);
     parallel_chunks(nv, 256, [&](int begin, int end) {
       RoundingGuard guard;
-      for (int g = begin; g < end; ++g) vertex[g] = vertex_of(planes, s.corner[seed[g]], known);
+      for (int g = begin; g < end; ++g)
+        vertex[g] = independent_vertex_of(planes, s.corner[seed[g]], known);
     });
   }
   // The vertex graph (edges between groups): each vertex's neighbours in increasing order,
@@ -1019,23 +1039,51 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   };
   // The candidate is a convex polytope. Every plane that is not a dual vertex must not cut
   // it: climb to its highest vertex (a local maximum is global on a convex polytope) and
-  // collect the vertices where it touches (sorted).
+  // collect the vertices where it touches (sorted). Where the plane is known to pass through
+  // a vertex (a known point: in a closing, every facet of S not on A touches A at its corners'
+  // vertices of A), the climb starts there and usually ends at once; where it does not, at
+  // the chunk's last vertex. The result does not depend on the start. Two vertices both
+  // known on the plane compare equal without arithmetic.
   std::vector<int> others;
   for (int p = 0; p < n; ++p)
     if (some_triangle[p] < 0) others.push_back(p);
+  std::vector<int> vertex_at_point;  // the vertex that is known point k, or -1
+  if (!known.empty()) {
+    vertex_at_point.assign(known.X.size(), -1);
+    for (int v = 0; v < nv; ++v)
+      if (vertex[v].known >= 0) vertex_at_point[vertex[v].known] = v;
+  }
   std::vector<std::vector<int>> touched(others.size());
   parallel_chunks(static_cast<int>(others.size()), 64, [&](int begin, int end) {
     RoundingGuard guard;
     int u = 0;
     std::vector<int> plateau;  // scratch: each list is then allocated once, at its size
+    std::vector<signed char> sides;
     for (int j = begin; j < end && ok; ++j) {
       const Plane& p = planes[others[j]];
       LazyPrecisePlane precise_p(p);
+      if (!known.empty())
+        for (int k = known.begin[others[j]]; k < known.begin[others[j] + 1]; ++k)
+          if (vertex_at_point[known.point[k]] >= 0) {
+            u = vertex_at_point[known.point[k]];
+            break;
+          }
+      // With u known on the plane, a neighbour compares with u as it lies to the plane (the
+      // cheaper test), and those sides (`sides`, when the climb ends there) start the plateau.
+      bool u_on = false;
       for (bool moved = true; moved;) {
         moved = false;
+        u_on = known_through(known, others[j], vertex[u]);
+        sides.clear();
         for (int a = adj_begin[u]; a < adj_begin[u + 1]; ++a) {
-          int s = compare_filter(p, precise_p, vertex[adj[a]], vertex[u]);
-          if (s == 2) s = compare_exact(p, exact_vertex(adj[a]), exact_vertex(u));
+          int s;
+          if (u_on) {
+            s = known_through(known, others[j], vertex[adj[a]]) ? 0 : side_of(p, precise_p, adj[a]);
+            sides.push_back(static_cast<signed char>(s));
+          } else {
+            s = compare_filter(p, precise_p, vertex[adj[a]], vertex[u]);
+            if (s == 2) s = compare_exact(p, exact_vertex(adj[a]), exact_vertex(u));
+          }
           if (s > 0) {
             u = adj[a];
             moved = true;
@@ -1043,15 +1091,16 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
           }
         }
       }
-      const int sd = known_through(known, others[j], vertex[u]) ? 0 : side_of(p, precise_p, u);
+      const int sd = u_on ? 0 : side_of(p, precise_p, u);
       if (sd > 0) ok = false;
       if (sd != 0) continue;
       plateau.assign(1, u);
       for (std::size_t q = 0; q < plateau.size(); ++q)
         for (int a = adj_begin[plateau[q]]; a < adj_begin[plateau[q] + 1]; ++a)
           if (std::find(plateau.begin(), plateau.end(), adj[a]) == plateau.end() &&
-              (known_through(known, others[j], vertex[adj[a]]) ||
-               side_of(p, precise_p, adj[a]) == 0))
+              (q == 0 && u_on ? sides[a - adj_begin[u]] == 0
+                              : known_through(known, others[j], vertex[adj[a]]) ||
+                                    side_of(p, precise_p, adj[a]) == 0))
             plateau.push_back(adj[a]);
       std::sort(plateau.begin(), plateau.end());
       touched[j].assign(plateau.begin(), plateau.end());
