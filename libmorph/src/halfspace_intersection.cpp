@@ -530,20 +530,29 @@ bool round_precise(const DD& X, double ex, const DD& W, double ew, double& out) 
     sum = std::abs(s.lo) + std::abs(X.lo) + std::abs(p.lo) + std::abs(q);
     return s.hi + (((s.lo + X.lo) - p.lo) - q);
   };
+  // X / W lies strictly between the midpoints to r's neighbours iff
+  // -(r - down) / 2 < R / W < (up - r) / 2 for R = X - r W; the exact W >= W.hi - |W.lo| - ew
+  // >= w_low > 0 (|W.lo| <= 2^-53 W.hi), and the half gaps are powers of two (products
+  // exact: no underflow in this range). X / W - r = R / W up to the errors: those of X and
+  // W, and of R's evaluation.
+  const double w_low = W.hi * (1 - 0x1p-50);
+  const auto rounds_to = [&](double r, double R) {
+    const double error = (ex + std::abs(r) * ew + 0x1p-50 * (sum + std::abs(R))) * 1.01 + 0x1p-1000;
+    const double up = step_away(r, r > 0) - r, down = r - step_away(r, r < 0);
+    return R + error < 0.5 * up * w_low && R - error > -0.5 * down * w_low;
+  };
+  // X.hi / W.hi is within about an ulp of X / W, and often its rounding already: tested
+  // first; otherwise moved by the residual, X / W to about 100 bits, and tested again.
   const double q1 = X.hi / W.hi;
   if (!(std::abs(q1) >= 0x1p-490 && std::abs(q1) <= 0x1p490)) return false;
-  const double r = q1 + residual(q1) / W.hi;  // X / W to about 100 bits: the candidate
+  const double R1 = residual(q1);
+  if (rounds_to(q1, R1)) {
+    out = q1;
+    return true;
+  }
+  const double r = q1 + R1 / W.hi;
   if (!(std::abs(r) >= 0x1p-500 && std::abs(r) <= 0x1p500)) return false;
-  const double R = residual(r);
-  // X / W - r = R / W up to the errors: those of X and W, and of R's evaluation.
-  const double error = (ex + std::abs(r) * ew + 0x1p-50 * (sum + std::abs(R))) * 1.01 + 0x1p-1000;
-  // X / W lies strictly between the midpoints to r's neighbours iff
-  // -(r - down) / 2 < R / W < (up - r) / 2; the exact W >= W.hi - |W.lo| - ew >= w_low > 0
-  // (|W.lo| <= 2^-53 W.hi), and the half gaps are powers of two (products exact: no
-  // underflow in this range).
-  const double w_low = W.hi * (1 - 0x1p-50);
-  const double up = step_away(r, r > 0) - r, down = r - step_away(r, r < 0);
-  if (!(R + error < 0.5 * up * w_low && R - error > -0.5 * down * w_low)) return false;
+  if (!rounds_to(r, residual(r))) return false;
   out = r;
   return true;
 }
@@ -857,7 +866,18 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     HVertex local;
     for (int t = begin; t < end && ok; ++t) {
       HVertex& v = stored ? s.vertex[t] : local;
-      if (!stored || !s.has_vertex[t]) v = independent_vertex_of(planes, s.corner[t], known);
+      if (!stored) {
+        // A polygon's triangles come in a row and, in a closing, share one known point: the
+        // previous triangle's vertex is then this one's (nothing copied again).
+        const int k =
+            known.empty() ? -1 : known.common(s.corner[t][0], s.corner[t][1], s.corner[t][2]);
+        if (k >= 0 && k == v.known)
+          v.planes = s.corner[t];
+        else
+          v = independent_vertex_of(planes, s.corner[t], known);
+      } else if (!s.has_vertex[t]) {
+        v = independent_vertex_of(planes, s.corner[t], known);
+      }
       for (int k = 0; k < 3; ++k) {
         const auto& cn = s.corner[s.across[t][k]];
         const int a = s.corner[t][k], b = s.corner[t][(k + 1) % 3];
