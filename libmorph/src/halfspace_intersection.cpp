@@ -830,11 +830,21 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   {
     const auto& c0 = s.corner[0];
     const V3<ExactN> r = planes[c0[0]].n + planes[c0[1]].n + planes[c0[2]].n;
+    // Planes whose normal points away from the ray (<r, n> < 0, by intervals): a triangle of
+    // three such is missed without its determinants (its cone holds no direction of positive
+    // dot with r; one of them would be negative).
+    std::vector<char> away(n);
+    parallel_chunks(n, 1024, [&](int begin, int end) {
+      RoundingGuard guard;
+      const V3<Interval> ri = to_interval_n(r);
+      for (int p = begin; p < end; ++p) away[p] = interval_sign(dot(ri, planes[p].ni)) < 0;
+    });
     std::atomic<int> hits = 0;
     parallel_chunks(nt, 512, [&](int begin, int end) {
       RoundingGuard guard;
       const Plane ray{r, ExactN(0), to_interval_n(r), Interval(0)};
       for (int t = begin; t < end && ok; ++t) {
+        if (away[s.corner[t][0]] && away[s.corner[t][1]] && away[s.corner[t][2]]) continue;
         const Plane &a = planes[s.corner[t][0]], &b = planes[s.corner[t][1]],
                     &c = planes[s.corner[t][2]];
         const int s0 = det_sign(ray, b, c);
