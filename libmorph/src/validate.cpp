@@ -62,7 +62,8 @@ struct MeshView {
         vertex_status(deleted_status(m, m.vertex_status_pph())),
         edge_status(deleted_status(m, m.edge_status_pph())),
         halfedge_status(deleted_status(m, m.halfedge_status_pph())),
-        face_status(deleted_status(m, m.face_status_pph())) {}
+        face_status(deleted_status(m, m.face_status_pph())),
+        arrays(m) {}
 
   const Mesh& mesh;
   const Point* points;
@@ -70,6 +71,7 @@ struct MeshView {
   // Null when no element of that kind is deleted (or the kind has no status).
   const OpenMesh::Attributes::StatusInfo *vertex_status, *edge_status, *halfedge_status,
       *face_status;
+  detail::HalfedgeArrays arrays;
 
   template <class StatusHandle>
   static const OpenMesh::Attributes::StatusInfo* deleted_status(const Mesh& m,
@@ -87,12 +89,12 @@ struct MeshView {
   bool live_face(int f) const { return !face_status || !face_status[f].deleted(); }
 
   // OpenMesh stores the two halfedges of edge e as 2e and 2e + 1.
-  int to(int h) const { return mesh.to_vertex_handle(Mesh::HalfedgeHandle(h)).idx(); }
-  int from(int h) const { return to(h ^ 1); }
-  int next(int h) const { return mesh.next_halfedge_handle(Mesh::HalfedgeHandle(h)).idx(); }
-  int face(int h) const { return mesh.face_handle(Mesh::HalfedgeHandle(h)).idx(); }
-  int halfedge_of_vertex(int v) const { return mesh.halfedge_handle(Mesh::VertexHandle(v)).idx(); }
-  int halfedge_of_face(int f) const { return mesh.halfedge_handle(Mesh::FaceHandle(f)).idx(); }
+  int to(int h) const { return arrays.to(h); }
+  int from(int h) const { return arrays.from(h); }
+  int next(int h) const { return arrays.next(h); }
+  int face(int h) const { return arrays.face(h); }
+  int halfedge_of_vertex(int v) const { return arrays.halfedge_of_vertex(v); }
+  int halfedge_of_face(int f) const { return arrays.halfedge_of_face(f); }
 };
 
 std::string vertex_pair(const MeshView& m, int edge) {
@@ -374,33 +376,31 @@ bool has_equal_pair(int n, const Key& key) {
 // names the problem.
 bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, double tolerance,
                      double zero_area, bool convexity, Geometry& geometry) {
-  const int* ids = cycles.corners(f);
-  const int* across = cycles.across.data() + cycles.begin[f];
+  const int b = cycles.begin[f];
+  const int* ids = cycles.vertex.data() + b;
   const int i0 = ids[0], i1 = ids[1], i2 = ids[2];
   if (i0 == i1 || i0 == i2 || i1 == i2) return false;
   const Point &p0 = m.points[i0], &p1 = m.points[i1], &p2 = m.points[i2];
-  // In plain doubles: OpenMesh's vector operations, one component at a time.
-  double c[3], normal[3];
-  for (int i = 0; i < 3; ++i) c[i] = (((0.0 + p0[i]) + p1[i]) + p2[i]) * (1.0 / 3);
-  double a[3][3];  // the corners relative to the centroid
-  for (int i = 0; i < 3; ++i) {
-    a[0][i] = p0[i] - c[i];
-    a[1][i] = p1[i] - c[i];
-    a[2][i] = p2[i] - c[i];
-  }
-  // cross(u, v) component i: u[j] v[l] - u[l] v[j] with (j, l) = (i + 1, i + 2) mod 3.
-  for (int i = 0; i < 3; ++i) {
-    const int j = (i + 1) % 3, l = (i + 2) % 3;
-    normal[i] = ((0.0 + (a[0][j] * a[1][l] - a[0][l] * a[1][j])) +
-                 (a[1][j] * a[2][l] - a[1][l] * a[2][j])) +
-                (a[2][j] * a[0][l] - a[2][l] * a[0][j]);
-  }
+  // In plain doubles, straight-line: OpenMesh's vector operations, one component at a time.
+  const double cx = (((0.0 + p0[0]) + p1[0]) + p2[0]) * (1.0 / 3);
+  const double cy = (((0.0 + p0[1]) + p1[1]) + p2[1]) * (1.0 / 3);
+  const double cz = (((0.0 + p0[2]) + p1[2]) + p2[2]) * (1.0 / 3);
+  // The corners relative to the centroid.
+  const double ax = p0[0] - cx, ay = p0[1] - cy, az = p0[2] - cz;
+  const double bx = p1[0] - cx, by = p1[1] - cy, bz = p1[2] - cz;
+  const double qx = p2[0] - cx, qy = p2[1] - cy, qz = p2[2] - cz;
+  // cross(u, v) component i: u[j] v[l] - u[l] v[j] with (j, l) = (i + 1, i + 2) mod 3,
+  // summed over the edges a-b, b-q, q-a from zero.
+  double nx = ((0.0 + (ay * bz - az * by)) + (by * qz - bz * qy)) + (qy * az - qz * ay);
+  double ny = ((0.0 + (az * bx - ax * bz)) + (bz * qx - bx * qz)) + (qz * ax - qx * az);
+  double nz = ((0.0 + (ax * by - ay * bx)) + (bx * qy - by * qx)) + (qx * ay - qy * ax);
   if (p0 == p1 || p0 == p2 || p1 == p2) return false;
-  const double length =
-      std::sqrt((normal[0] * normal[0] + normal[1] * normal[1]) + normal[2] * normal[2]);
+  const double length = std::sqrt((nx * nx + ny * ny) + nz * nz);
   if (!(length > zero_area)) return false;
   const double inverse = 1.0 / length;
-  for (double& x : normal) x *= inverse;
+  nx *= inverse;
+  ny *= inverse;
+  nz *= inverse;
   {
     const Point& o = geometry.extent.centre;
     const double u[3] = {p2[0] - o[0], p2[1] - o[1], p2[2] - o[2]};
@@ -411,49 +411,40 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, double 
     geometry.volumes.total += six_v;
     geometry.volumes.absolute += std::abs(six_v);
   }
-  // The points whose height above the plane the checks read: the corners (planarity),
-  // then the corner of each neighbouring triangle off the common edge (convexity).
-  const bool reflex = convexity && !geometry.reflex;
-  const Point* points[6] = {&p0, &p1, &p2};
-  int count = 3;
-  bool polygon_across = false;  // a neighbour is not a triangle: checked after
-  if (reflex) {
-    const int from[3] = {i2, i0, i1}, to[3] = {i0, i1, i2};
-    for (int k = 0; k < 3; ++k) {
-      const int g = across[k];
-      if (cycles.degree(g) != 3) {
-        polygon_across = true;
-        continue;
-      }
-      const int* corners = cycles.corners(g);
-      const int v = corners[0] != from[k] && corners[0] != to[k]   ? corners[0]
-                    : corners[1] != from[k] && corners[1] != to[k] ? corners[1]
-                                                                   : corners[2];
-      points[count++] = &m.points[v];
-    }
-  }
   // height(plane, p): dot(p - centroid, normal), summed in OpenMesh's order.
-  const double nx = normal[0], ny = normal[1], nz = normal[2];
-  const double cx = c[0], cy = c[1], cz = c[2];
-  double height[6];
-  for (int k = 0; k < count; ++k) {
-    const Point& p = *points[k];
-    height[k] = (p[0] - cx) * nx + (p[1] - cy) * ny + (p[2] - cz) * nz;
-  }
+  const auto height = [&](const Point& p) {
+    return (p[0] - cx) * nx + (p[1] - cy) * ny + (p[2] - cz) * nz;
+  };
   if (geometry.non_planar_face < 0 &&
-      !(std::abs(height[0]) <= tolerance && std::abs(height[1]) <= tolerance &&
-        std::abs(height[2]) <= tolerance))
+      !(std::abs(height(p0)) <= tolerance && std::abs(height(p1)) <= tolerance &&
+        std::abs(height(p2)) <= tolerance))
     geometry.non_planar_face = f;
-  if (reflex) {
-    for (int k = 3; k < count; ++k) geometry.reflex = geometry.reflex || !(height[k] <= tolerance);
-    if (polygon_across && !geometry.reflex) {
-      const FacePlane plane{Point(cx, cy, cz), Point(nx, ny, nz)};
-      const int from[3] = {i2, i0, i1}, to[3] = {i0, i1, i2};
-      for (int k = 0; k < 3 && !geometry.reflex; ++k)
-        if (cycles.degree(across[k]) != 3)
-          geometry.reflex = reflex_across(m, cycles, plane, across[k], from[k], to[k], tolerance);
+  if (!convexity || geometry.reflex) return true;
+  // The corner of each neighbouring triangle off the common edge from -> to (the edge that
+  // ends at corner k); a neighbour that is not a triangle is checked after.
+  const int* across = cycles.across.data() + b;
+  const int from[3] = {i2, i0, i1}, to[3] = {i0, i1, i2};
+  bool reflex = false, polygon_across = false;
+  for (int k = 0; k < 3; ++k) {
+    const int g = across[k];
+    const int gb = cycles.begin[g];
+    if (cycles.begin[g + 1] - gb != 3) {
+      polygon_across = true;
+      continue;
     }
+    const int* corners = cycles.vertex.data() + gb;
+    const int v = corners[0] != from[k] && corners[0] != to[k]   ? corners[0]
+                  : corners[1] != from[k] && corners[1] != to[k] ? corners[1]
+                                                                 : corners[2];
+    reflex = reflex || !(height(m.points[v]) <= tolerance);
   }
+  if (polygon_across && !reflex) {
+    const FacePlane plane{Point(cx, cy, cz), Point(nx, ny, nz)};
+    for (int k = 0; k < 3 && !reflex; ++k)
+      if (cycles.degree(across[k]) != 3)
+        reflex = reflex_across(m, cycles, plane, across[k], from[k], to[k], tolerance);
+  }
+  geometry.reflex = reflex;
   return true;
 }
 
