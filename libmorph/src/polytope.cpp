@@ -198,6 +198,19 @@ UnitNormal unit_newell(const std::vector<V3<double>>& points, const int* corners
   const V3<double>& o = points[corners[0]];
   V3<double> sum{0, 0, 0}, magnitude{0, 0, 0};
   V3<double> a = points[corners[1]] - o;
+  if (d == 3) {
+    // The loop below run once, written out (most facets are triangles): the same values.
+    const V3<double> b = points[corners[2]] - o;
+    const double xy = a.y * b.z, xz = a.z * b.y, yz = a.z * b.x, yx = a.x * b.z, zx = a.x * b.y,
+                 zy = a.y * b.x;
+    sum = {0.0 + (xy - xz), 0.0 + (yz - yx), 0.0 + (zx - zy)};
+    const double factor = 5 * kUlp * 1.01, absolute = 3 * 0x1p-1000;
+    return normalised(sum, (factor * ((0.0 + (std::abs(xy) + std::abs(xz))) +
+                                      (0.0 + (std::abs(yz) + std::abs(yx))) +
+                                      (0.0 + (std::abs(zx) + std::abs(zy)))) +
+                            3 * absolute) *
+                               1.01);
+  }
   for (int k = 2; k < d; ++k) {
     const V3<double> b = points[corners[k]] - o;
     const double xy = a.y * b.z, xz = a.z * b.y, yz = a.z * b.x, yx = a.x * b.z, zx = a.x * b.y,
@@ -514,17 +527,24 @@ void check_gauss_map(const Polytope& p, const char* name) {
     if (n < 3)
       fail(name, "vertex " + std::to_string(p.vertex_source[v]) + " has fewer than three facets");
     const int* fan = &p.fan_face[b];
-    for (int i = 0, j = 1, k = 2; i < n; ++i, j = k, k = k + 1 == n ? 0 : k + 1) {
+    // Triple i is (fan[i], fan[i + 1], fan[i + 2]) cyclically: each step reads one new normal.
+    const UnitNormal *px = &unit[fan[0]], *py = &unit[fan[1]];
+    for (int i = 0; i < n; ++i) {
+      const int k = i + 2 < n ? i + 2 : i + 2 - n;
+      const UnitNormal* pz = &unit[fan[k]];
       // orient_normals' double filter, on the unit normals read straight from the array
       // (the same expression and bound); its later stages decide what it leaves.
-      const UnitNormal &x = unit[fan[i]], &y = unit[fan[j]], &z = unit[fan[k]];
+      const UnitNormal &x = *px, &y = *py, &z = *pz;
+      px = py;
+      py = pz;
       const double d = x.x * (y.y * z.z - y.z * z.y) + x.y * (y.z * z.x - y.x * z.z) +
                        x.z * (y.x * z.y - y.y * z.x);
       const double bound = x.error + y.error + z.error + kUnitPredicateRounding;
       if (d > bound) continue;
       const int s = d < -bound
                         ? -1
-                        : orient_normals_undecided(NormalRef{&p, fan[i]}, NormalRef{&p, fan[j]},
+                        : orient_normals_undecided(NormalRef{&p, fan[i]},
+                                                   NormalRef{&p, fan[i + 1 < n ? i + 1 : 0]},
                                                    NormalRef{&p, fan[k]});
       if (s <= 0)
         fail(name, "the facets around vertex " + std::to_string(p.vertex_source[v]) +
@@ -578,27 +598,28 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   std::unique_ptr<FanLink[]> link(new FanLink[nh]);
   p.face_begin.resize(nf + 1);
   p.corner_vertex.resize(nh);
+  const HalfedgeArrays arrays(mesh);
   int c = 0;
   for (int f = 0; f < nf; ++f) {
     p.face_begin[f] = c;
-    const auto h0 = mesh.halfedge_handle(Mesh::FaceHandle(f));
+    const int h0 = arrays.halfedge_of_face(f);
     // The face circulator starts at the target of h0. As given, a corner's vertex is the
     // target of the halfedge before it (read with the link to the next one).
-    const auto start = reversed ? mesh.prev_halfedge_handle(h0) : mesh.next_halfedge_handle(h0);
-    int from = mesh.to_vertex_handle(h0).idx();
-    auto h = start;
+    const int start = reversed ? arrays.prev(h0) : arrays.next(h0);
+    int from = arrays.to(h0);
+    int h = start;
     do {
       // Each halfedge once: with the count below, every halfedge is some face's.
-      if (c == nh || corner_of[h.idx()] >= 0)
+      if (c == nh || corner_of[h] >= 0)
         throw error("internal error: a mesh face is not a closed cycle");
-      p.corner_vertex[c] = reversed ? mesh.to_vertex_handle(h).idx() : from;
-      corner_halfedge[c] = h.idx();
+      p.corner_vertex[c] = reversed ? arrays.to(h) : from;
+      corner_halfedge[c] = h;
       link[c].face = f;
       link[c].prev = c - 1;
-      corner_of[h.idx()] = c;
+      corner_of[h] = c;
       ++c;
-      if (!reversed) from = mesh.to_vertex_handle(h).idx();
-      h = reversed ? mesh.prev_halfedge_handle(h) : mesh.next_halfedge_handle(h);
+      if (!reversed) from = arrays.to(h);
+      h = reversed ? arrays.prev(h) : arrays.next(h);
     } while (h != start);
     link[p.face_begin[f]].prev = c - 1;
   }
@@ -614,23 +635,25 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   // counter-clockwise is across the incoming edge u -> v, at corner twin(prev corner),
   // precomputed so that the fan walk below follows one link per step, as
   // build_connectivity walks them) and the last corner at each vertex, where its fan starts.
-  std::vector<int> mesh_edge;
-  mesh_edge.reserve(mesh.n_edges());
-  p.edges.clear();
-  p.edges.reserve(mesh.n_edges());
+  // Each edge has two corners (every halfedge is one face's): nc / 2 edges, written by index.
+  const int ne = nc / 2;
+  std::vector<int> mesh_edge(ne);
+  p.edges.resize(ne);
   p.corner_edge.resize(nc);
   std::vector<int> some_corner(nv, -1);
+  int e = 0;
   for (c = 0; c < nc; ++c) {
     FanLink& l = link[c];
     l.next = twin(l.prev);
     some_corner[p.corner_vertex[c]] = c;
     const int t = twin(c);
     if (t < c) continue;  // numbered at t
-    const int e = static_cast<int>(p.edges.size());
-    p.edges.push_back({p.corner_vertex[c], p.corner_vertex[t], l.face, link[t].face});
-    mesh_edge.push_back(corner_halfedge[c] >> 1);
+    if (e == ne) throw error("internal error: a mesh edge has one face");
+    p.edges[e] = {p.corner_vertex[c], p.corner_vertex[t], l.face, link[t].face};
+    mesh_edge[e] = corner_halfedge[c] >> 1;
     p.corner_edge[c] = e;
     p.corner_edge[t] = e;
+    ++e;
   }
   p.fan_begin.resize(nv + 1);
   p.fan_face.resize(nc);
