@@ -10,6 +10,7 @@
 #include <exception>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <string>
 #include <unordered_map>
 
@@ -541,11 +542,10 @@ void check_gauss_map(const Polytope& p, const char* name) {
                        x.z * (y.x * z.y - y.y * z.x);
       const double bound = x.error + y.error + z.error + kUnitPredicateRounding;
       if (d > bound) continue;
-      const int s = d < -bound
-                        ? -1
-                        : orient_normals_undecided(NormalRef{&p, fan[i]},
-                                                   NormalRef{&p, fan[i + 1 < n ? i + 1 : 0]},
-                                                   NormalRef{&p, fan[k]});
+      const int s = d < -bound ? -1
+                               : orient_normals_undecided(NormalRef{&p, fan[i]},
+                                                          NormalRef{&p, fan[i + 1 < n ? i + 1 : 0]},
+                                                          NormalRef{&p, fan[k]});
       if (s <= 0)
         fail(name, "the facets around vertex " + std::to_string(p.vertex_source[v]) +
                        " do not turn convexly (the mesh is not convex)");
@@ -575,12 +575,57 @@ bool is_canonical(const Polytope& p) {
   return true;
 }
 
+/// The rest of check_operand's topological checks on a mesh whose halfedges
+/// connectivity_from_halfedges found consistent (every vertex one fan reaching each
+/// neighbour once): every vertex's halfedge leaves it (where the check's fan walk starts),
+/// the vertices are connected, and V - E + F = 2.
+bool operand_topology(const Polytope& p, const HalfedgeArrays& arrays, int nf) {
+  const int nv = p.num_vertices();
+  const int nh = static_cast<int>(p.corner_vertex.size());
+  for (int v = 0; v < nv; ++v) {
+    const int h = arrays.halfedge_of_vertex(v);
+    if (h < 0 || h >= nh || arrays.to(h ^ 1) != v) return false;
+  }
+  // A search through the fans from vertex 0, as the check's.
+  std::vector<char> reached(nv, 0);
+  std::vector<int> stack;
+  stack.reserve(nv);
+  int count = 0;
+  if (nv > 0) {
+    reached[0] = 1;
+    stack.push_back(0);
+  }
+  while (!stack.empty()) {
+    const int v = stack.back();
+    stack.pop_back();
+    ++count;
+    for (int s = p.fan_begin[v]; s < p.fan_begin[v + 1]; ++s) {
+      const int w = p.fan_vertex[s];
+      if (reached[w]) continue;
+      reached[w] = 1;
+      stack.push_back(w);
+    }
+  }
+  return count == nv && static_cast<long long>(nv) - nh / 2 + nf == 2;
+}
+
+/// What make_operand's checked path (checked_polytope) reads off the halfedges beside the
+/// polytope's connectivity: the face across the edge that ends at each corner (check_operand's
+/// face cycles, see FaceCycleView), and whether the mesh passes check_operand's topological
+/// checks.
+struct OperandTopology {
+  std::vector<int> across;
+  bool passes = false;
+};
+
 /// Faces, edges and fans of `p` straight from the halfedges of `mesh` (closed, manifold,
 /// no deleted elements), each facet reversed if `order` says so. The numbering is the one
 /// build_connectivity gives the mesh's face cycles: facets in face order, corners from the
 /// face circulator's first vertex, edges in order of first use. Returns the mesh edge of
-/// each polytope edge.
-std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, FaceOrder order) {
+/// each polytope edge. With `topology` (as given only), also tells whether check_operand's
+/// topological checks pass, from what the walks read anyway (see checked_polytope).
+std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, FaceOrder order,
+                                             OperandTopology* topology = nullptr) {
   const int nv = static_cast<int>(mesh.n_vertices());
   const int nf = static_cast<int>(mesh.n_faces());
   const int nh = static_cast<int>(mesh.n_halfedges());
@@ -599,6 +644,15 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   p.face_begin.resize(nf + 1);
   p.corner_vertex.resize(nh);
   const HalfedgeArrays arrays(mesh);
+  // The checked path's findings: whether every halfedge names the face whose cycle holds
+  // it and its opposite ends at the corner's vertex (the check reads both), and `across`.
+  bool consistent = true;
+  int* across = nullptr;
+  if (topology) {
+    topology->passes = false;
+    topology->across.resize(nh);
+    across = topology->across.data();
+  }
   int c = 0;
   for (int f = 0; f < nf; ++f) {
     p.face_begin[f] = c;
@@ -607,6 +661,7 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
     // target of the halfedge before it (read with the link to the next one).
     const int start = reversed ? arrays.prev(h0) : arrays.next(h0);
     int from = arrays.to(h0);
+    int entering = h0;  // the halfedge that ends at the corner (as given)
     int h = start;
     do {
       // Each halfedge once: with the count below, every halfedge is some face's.
@@ -617,6 +672,11 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
       link[c].face = f;
       link[c].prev = c - 1;
       corner_of[h] = c;
+      if (topology) {
+        across[c] = arrays.face(entering ^ 1);
+        consistent = consistent && arrays.face(h) == f && arrays.to(h ^ 1) == from;
+        entering = h;
+      }
       ++c;
       if (!reversed) from = arrays.to(h);
       h = reversed ? arrays.prev(h) : arrays.next(h);
@@ -660,23 +720,35 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   p.fan_edge.resize(nc);
   p.fan_vertex.resize(nc);
   int slot = 0;
+  // The checked path: the vertex whose fan last reached each vertex (a neighbour reached
+  // twice means two edges between the same vertices).
+  std::vector<int> seen(topology ? nv : 0, -1);
   for (int v = 0; v < nv; ++v) {
     p.fan_begin[v] = slot;
     const int first = some_corner[v];
-    if (first < 0) continue;
+    if (first < 0) {
+      consistent = false;  // isolated
+      continue;
+    }
     c = first;
     do {
       if (slot == nc) throw error("internal error: a mesh vertex has a broken fan");
       const FanLink& l = link[c];
       p.fan_face[slot] = l.face;
       p.fan_edge[slot] = p.corner_edge[l.prev];
-      p.fan_vertex[slot] = p.corner_vertex[l.prev];
+      const int w = p.corner_vertex[l.prev];
+      p.fan_vertex[slot] = w;
+      if (topology) {
+        consistent = consistent && seen[w] != v;
+        seen[w] = v;
+      }
       ++slot;
       c = l.next;
     } while (c != first);
   }
   p.fan_begin[nv] = slot;
   if (slot != nc) throw error("internal error: a mesh vertex has several fans");
+  if (topology && consistent) topology->passes = operand_topology(p, arrays, nf);
   return mesh_edge;
 }
 
@@ -897,13 +969,12 @@ Polytope make_polytope_from_cycles(const Mesh& mesh, const char* name, FaceOrder
   return p;
 }
 
-Polytope make_polytope(const Mesh& mesh, const char* name, FaceOrder order) {
-  if (has_deleted_elements(mesh)) return make_polytope_from_cycles(mesh, name, order);
-  Polytope p;
-  p.points.resize(mesh.n_vertices());
-  const Point* q = mesh.points();
-  for (int v = 0; v < p.num_vertices(); ++v) p.points[v] = {q[v][0], q[v][1], q[v][2]};
-  std::vector<int> mesh_edge = connectivity_from_halfedges(p, mesh, order);
+namespace {
+
+/// make_polytope(mesh, name, order) once connectivity_from_halfedges has filled p's facets,
+/// edges and fans: the normals, the canonical form, the labels and the Gauss map.
+Polytope finish_from_halfedges(Polytope p, std::vector<int> mesh_edge, const Mesh& mesh,
+                               const char* name, FaceOrder order) {
   p.compute_normals();
   if (!is_canonical(p)) return make_polytope_from_cycles(mesh, name, order);
   p.vertex_source.resize(p.num_vertices());
@@ -916,13 +987,56 @@ Polytope make_polytope(const Mesh& mesh, const char* name, FaceOrder order) {
   return p;
 }
 
+void copy_points(Polytope& p, const Mesh& mesh) {
+  p.points.resize(mesh.n_vertices());
+  const Point* q = mesh.points();
+  for (int v = 0; v < p.num_vertices(); ++v) p.points[v] = {q[v][0], q[v][1], q[v][2]};
+}
+
+/// make_operand(mesh, name) in one pass for a mesh that is an operand as it is (the usual
+/// case): the halfedge walks that build the polytope also find whether check_operand's
+/// topological checks pass, and its geometric checks then run on the polytope's facet cycles
+/// (geometry_passes), so the mesh's connectivity is read once. Returns nothing when the check
+/// would not pass the mesh as it is (an error, an inverted mesh, a deleted element) or the
+/// walks meet anything unusual: make_operand then checks and builds as before, for the same
+/// messages. The polytope is make_polytope(mesh, name)'s, built by the same code.
+std::optional<Polytope> checked_polytope(const Mesh& mesh, const char* name) {
+  if (mesh.n_faces() == 0 || has_deleted_elements(mesh) || !readable(mesh)) return std::nullopt;
+  Polytope p;
+  copy_points(p, mesh);
+  OperandTopology topology;
+  std::vector<int> mesh_edge;
+  try {
+    mesh_edge = connectivity_from_halfedges(p, mesh, FaceOrder::as_given, &topology);
+  } catch (const error&) {  // a broken face cycle or fan: the check names it
+    return std::nullopt;
+  }
+  if (!topology.passes ||
+      !geometry_passes(mesh, {p.face_begin.data(), p.corner_vertex.data(), topology.across.data()}))
+    return std::nullopt;
+  topology = {};  // not needed by the rest of the build
+  return finish_from_halfedges(std::move(p), std::move(mesh_edge), mesh, name, FaceOrder::as_given);
+}
+
+}  // namespace
+
+Polytope make_polytope(const Mesh& mesh, const char* name, FaceOrder order) {
+  if (has_deleted_elements(mesh)) return make_polytope_from_cycles(mesh, name, order);
+  Polytope p;
+  copy_points(p, mesh);
+  std::vector<int> mesh_edge = connectivity_from_halfedges(p, mesh, order);
+  return finish_from_halfedges(std::move(p), std::move(mesh_edge), mesh, name, order);
+}
+
 Polytope make_operand(const Mesh& mesh, const char* name) {
-  // The polytope is built while the mesh is checked (on another thread when there is one),
-  // as if the mesh were valid and outward: its halfedges are read before the check has
-  // passed, which is safe once every coordinate is finite (all make_polytope's other
-  // assumptions, a closed mesh first, are tested as it goes, or only make it throw). The
-  // check's verdict decides: its error wins, an inverted mesh is built again reversed, and
-  // otherwise the build's result (or error) is the one the sequential order would give.
+  if (std::optional<Polytope> p = checked_polytope(mesh, name)) return std::move(*p);
+  // Anything else (an error, an inverted mesh, deleted elements): the polytope is built while the
+  // mesh is checked (on another thread when there is one), as if the mesh were valid and outward:
+  // its halfedges are read before the check has passed, which is safe once every coordinate is
+  // finite (all make_polytope's other assumptions, a closed mesh first, are tested as it goes, or
+  // only make it throw). The check's verdict decides: its error wins, an inverted mesh is built
+  // again reversed, and otherwise the build's result (or error) is the one the sequential order
+  // would give.
   std::atomic<bool> rejected{false};
   bool inverted = false, built = false;
   Polytope p;

@@ -125,24 +125,31 @@ Extent bounding_box(const MeshView& m) {
 // at the target of the face's halfedge), read once for all the geometric checks. A
 // deleted face has an empty cycle.
 struct FaceCycles {
-  std::vector<int> begin;   // size F + 1, over all faces
-  std::vector<int> vertex;  // corner k of face f: vertex[begin[f] + k]
-  std::vector<int> across;  // the face across the edge that ends at corner k (if any)
+  FaceCycles() = default;
+  FaceCycles(FaceCycles&&) = default;  // the arrays keep their buffers
+  FaceCycles& operator=(FaceCycles&&) = default;
+  // Over all faces: begin has size F + 1; corner k of face f is vertex[begin[f] + k], and
+  // across[begin[f] + k] the face across the edge that ends at it (if any). Either the
+  // stores below (face_cycles()) or a caller's arrays (detail::FaceCycleView).
+  const int* begin = nullptr;
+  const int* vertex = nullptr;
+  const int* across = nullptr;
+  std::vector<int> begin_store, vertex_store, across_store;
   int degree(int f) const { return begin[f + 1] - begin[f]; }
-  const int* corners(int f) const { return vertex.data() + begin[f]; }
+  const int* corners(int f) const { return vertex + begin[f]; }
 };
 
 FaceCycles face_cycles(const MeshView& m) {
   FaceCycles cycles;
-  cycles.begin.resize(m.n_faces + 1);
+  cycles.begin_store.resize(m.n_faces + 1);
   // At most one corner per halfedge: written by index, trimmed at the end.
-  cycles.vertex.resize(m.n_halfedges);
-  cycles.across.resize(m.n_halfedges);
-  int* const vertex = cycles.vertex.data();
-  int* const across = cycles.across.data();
+  cycles.vertex_store.resize(m.n_halfedges);
+  cycles.across_store.resize(m.n_halfedges);
+  int* const vertex = cycles.vertex_store.data();
+  int* const across = cycles.across_store.data();
   int c = 0;
   for (int f = 0; f < m.n_faces; ++f) {
-    cycles.begin[f] = c;
+    cycles.begin_store[f] = c;
     if (!m.live_face(f)) continue;
     const int first = m.halfedge_of_face(f);
     int h = first;
@@ -156,9 +163,10 @@ FaceCycles face_cycles(const MeshView& m) {
       h = m.next(h);
     } while (h != first);
   }
-  cycles.begin[m.n_faces] = c;
-  cycles.vertex.resize(c);
-  cycles.across.resize(c);
+  cycles.begin_store[m.n_faces] = c;
+  cycles.begin = cycles.begin_store.data();
+  cycles.vertex = vertex;
+  cycles.across = across;
   return cycles;
 }
 
@@ -377,7 +385,7 @@ bool has_equal_pair(int n, const Key& key) {
 bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, double tolerance,
                      double zero_area, bool convexity, Geometry& geometry) {
   const int b = cycles.begin[f];
-  const int* ids = cycles.vertex.data() + b;
+  const int* ids = cycles.vertex + b;
   const int i0 = ids[0], i1 = ids[1], i2 = ids[2];
   if (i0 == i1 || i0 == i2 || i1 == i2) return false;
   const Point &p0 = m.points[i0], &p1 = m.points[i1], &p2 = m.points[i2];
@@ -422,7 +430,7 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, double 
   if (!convexity || geometry.reflex) return true;
   // The corner of each neighbouring triangle off the common edge from -> to (the edge that
   // ends at corner k); a neighbour that is not a triangle is checked after.
-  const int* across = cycles.across.data() + b;
+  const int* across = cycles.across + b;
   const int from[3] = {i2, i0, i1}, to[3] = {i0, i1, i2};
   bool reflex = false, polygon_across = false;
   for (int k = 0; k < 3; ++k) {
@@ -432,7 +440,7 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, double 
       polygon_across = true;
       continue;
     }
-    const int* corners = cycles.vertex.data() + gb;
+    const int* corners = cycles.vertex + gb;
     const int v = corners[0] != from[k] && corners[0] != to[k]   ? corners[0]
                   : corners[1] != from[k] && corners[1] != to[k] ? corners[1]
                                                                  : corners[2];
@@ -467,7 +475,7 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
                                       ") is outside the supported range [" + number(kMinSize) +
                                       ", " + number(kMaxSize) + "]");
   const double tolerance = relative_tolerance * diagonal;
-  geometry.cycles = face_cycles(m);
+  if (!geometry.cycles.begin) geometry.cycles = face_cycles(m);  // unless the caller's
   const double zero_area = kZeroAreaRatio * diagonal * diagonal;
   for (int f = 0; f < m.n_faces; ++f) {
     if (!m.live_face(f)) continue;
@@ -497,7 +505,7 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
     for (int k = 0; k < n && geometry.non_planar_face < 0; ++k)
       if (!(std::abs(height(plane, m.points[ids[k]])) <= tolerance)) geometry.non_planar_face = f;
     if (convexity && !geometry.reflex) {
-      const int* across = geometry.cycles.across.data() + geometry.cycles.begin[f];
+      const int* across = geometry.cycles.across + geometry.cycles.begin[f];
       for (int k = 0; k < n && !geometry.reflex; ++k)
         geometry.reflex = reflex_across(m, geometry.cycles, plane, across[k],
                                         ids[k == 0 ? n - 1 : k - 1], ids[k], tolerance);
@@ -640,6 +648,21 @@ std::optional<PreparedMesh> check_operand(const Mesh& mesh, std::string_view nam
   found = convex_polyhedron(prepared.mesh, options.planarity_tolerance);
   if (found.verdict != Verdict::ok) raise(found);
   return prepared;
+}
+
+bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles, double planarity_tolerance) {
+  // convex_polyhedron() after closed_manifold(), on the caller's cycles: the same checks on
+  // the same values, without building the messages of a failure.
+  const MeshView m(mesh);
+  Geometry geometry;
+  geometry.cycles.begin = cycles.begin;
+  geometry.cycles.vertex = cycles.vertex;
+  geometry.cycles.across = cycles.across;
+  if (nondegenerate(m, planarity_tolerance, geometry, true).verdict != Verdict::ok) return false;
+  if (outward(geometry.volumes).verdict != Verdict::ok) return false;
+  // A reflex flag means planar_and_convex() finds a reflex edge (the same test on the same
+  // face, edge and vertex): no need to look for it.
+  return geometry.non_planar_face < 0 && !geometry.reflex;
 }
 
 }  // namespace detail

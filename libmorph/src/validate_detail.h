@@ -55,4 +55,23 @@ struct HalfedgeArrays {
 std::optional<PreparedMesh> check_operand(const Mesh& mesh, std::string_view name,
                                           const ValidationOptions& options = {});
 
+/// A mesh's face cycles as check_operand reads them: corner k of face f is vertex
+/// vertex[begin[f] + k], counted from the target of the face's halfedge along its next
+/// links, and across[begin[f] + k] is the face across the edge that ends at that corner
+/// (begin has F + 1 entries).
+struct FaceCycleView {
+  const int* begin;
+  const int* vertex;
+  const int* across;
+};
+
+/// Whether check_operand(mesh) (with this tolerance) returns nothing: the mesh is an operand
+/// as it is. Only for a mesh without deleted elements that the caller has found to pass
+/// check_operand's topological checks (closed, every vertex one fan reaching each neighbour
+/// once, connected, Euler characteristic 2), with its face cycles: runs the geometric checks
+/// alone, on the same values with the same verdicts. False when check_operand would throw
+/// or flip the mesh (its caller then calls it, for the message). Linear in the mesh.
+bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles,
+                     double planarity_tolerance = kPlanarityTolerance);
+
 }  // namespace morph::detail
