@@ -432,6 +432,22 @@ TEST_CASE("polytope: make_operand's one-pass check gives the check's verdicts") 
             "shifted triangles " + what);
       }
   }
+  SUBCASE("a mesh large enough to check beside the build, with one thread or two") {
+    const Mesh sphere = morph::read_mesh(std::string(MORPH_SAMPLES_DIR) + "/icosphere_1280.off");
+    REQUIRE(sphere.n_faces() >= 1000);
+    for (int threads : {1, 2}) {
+      CAPTURE(threads);
+      tbb::task_arena arena(threads);
+      arena.execute([&] {
+        check_operand_agrees(sphere, "sphere");
+        for (const double s : {0.9, 1 - 1e-12, 1 + 1e-12, 1.1}) {
+          Mesh bent = sphere;
+          bent.set_point(Mesh::VertexHandle(0), sphere.point(Mesh::VertexHandle(0)) * s);
+          check_operand_agrees(bent, "vertex 0 scaled by " + std::to_string(s));
+        }
+      });
+    }
+  }
   SUBCASE("random polytopes, scaled and shifted") {
     for (std::uint64_t seed = 1; seed <= 6; ++seed) {
       const Mesh sphere = morph::test::random_sphere_polytope(80, seed);

@@ -702,18 +702,21 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   p.corner_edge.resize(nc);
   std::vector<int> some_corner(nv, -1);
   int e = 0;
-  for (c = 0; c < nc; ++c) {
-    FanLink& l = link[c];
-    l.next = twin(l.prev);
-    some_corner[p.corner_vertex[c]] = c;
-    const int t = twin(c);
-    if (t < c) continue;  // numbered at t
-    if (e == ne) throw error("internal error: a mesh edge has one face");
-    p.edges[e] = {p.corner_vertex[c], p.corner_vertex[t], l.face, link[t].face};
-    mesh_edge[e] = corner_halfedge[c] >> 1;
-    p.corner_edge[c] = e;
-    p.corner_edge[t] = e;
-    ++e;
+  for (int f = 0; f < nf; ++f) {
+    const int begin = p.face_begin[f], end = p.face_begin[f + 1];
+    for (c = begin; c < end; ++c) {
+      const int t = twin(c);
+      // c is the previous corner of the facet's next one, whose fan link is twin(c).
+      link[c + 1 == end ? begin : c + 1].next = t;
+      some_corner[p.corner_vertex[c]] = c;
+      if (t < c) continue;  // numbered at t
+      if (e == ne) throw error("internal error: a mesh edge has one face");
+      p.edges[e] = {p.corner_vertex[c], p.corner_vertex[t], f, link[t].face};
+      mesh_edge[e] = corner_halfedge[c] >> 1;
+      p.corner_edge[c] = e;
+      p.corner_edge[t] = e;
+      ++e;
+    }
   }
   p.fan_begin.resize(nv + 1);
   p.fan_face.resize(nc);
@@ -972,8 +975,9 @@ Polytope make_polytope_from_cycles(const Mesh& mesh, const char* name, FaceOrder
 namespace {
 
 /// make_polytope(mesh, name, order) once connectivity_from_halfedges has filled p's facets,
-/// edges and fans: the normals, the canonical form, the labels and the Gauss map.
-Polytope finish_from_halfedges(Polytope p, std::vector<int> mesh_edge, const Mesh& mesh,
+/// edges and fans: the normals, the canonical form, the labels and the Gauss map. The facet
+/// cycles are only read (they end in the result, or stay in p).
+Polytope finish_from_halfedges(Polytope& p, std::vector<int> mesh_edge, const Mesh& mesh,
                                const char* name, FaceOrder order) {
   p.compute_normals();
   if (!is_canonical(p)) return make_polytope_from_cycles(mesh, name, order);
@@ -984,8 +988,12 @@ Polytope finish_from_halfedges(Polytope p, std::vector<int> mesh_edge, const Mes
   p.edge_source = std::move(mesh_edge);
   // Every edge is strictly convex (is_canonical); the Gauss map is left to check.
   check_gauss_map(p, name);
-  return p;
+  return std::move(p);
 }
+
+// Below this many facets, checked_polytope checks and builds in sequence even when threads
+// allow: waking a worker costs more than the shorter of the two halves.
+constexpr int kParallelOperandFaces = 1000;
 
 void copy_points(Polytope& p, const Mesh& mesh) {
   p.points.resize(mesh.n_vertices());
@@ -1002,6 +1010,11 @@ void copy_points(Polytope& p, const Mesh& mesh) {
 /// messages. The polytope is make_polytope(mesh, name)'s, built by the same code.
 std::optional<Polytope> checked_polytope(const Mesh& mesh, const char* name) {
   if (mesh.n_faces() == 0 || has_deleted_elements(mesh) || !readable(mesh)) return std::nullopt;
+  if (mesh.has_halfedge_status()) {  // the check counts only live halfedges
+    const auto& status = mesh.property(mesh.halfedge_status_pph()).data_vector();
+    if (std::any_of(status.begin(), status.end(), [](const auto& s) { return s.deleted(); }))
+      return std::nullopt;
+  }
   Polytope p;
   copy_points(p, mesh);
   OperandTopology topology;
@@ -1011,11 +1024,37 @@ std::optional<Polytope> checked_polytope(const Mesh& mesh, const char* name) {
   } catch (const error&) {  // a broken face cycle or fan: the check names it
     return std::nullopt;
   }
-  if (!topology.passes ||
-      !geometry_passes(mesh, {p.face_begin.data(), p.corner_vertex.data(), topology.across.data()}))
-    return std::nullopt;
-  topology = {};  // not needed by the rest of the build
-  return finish_from_halfedges(std::move(p), std::move(mesh_edge), mesh, name, FaceOrder::as_given);
+  if (!topology.passes) return std::nullopt;
+  // The geometric checks and the rest of the build both only read the facet cycles: beside
+  // each other when threads allow, the build first in the order given to run_both, and with
+  // one thread the check first. The check's verdict decides, as in make_operand.
+  std::atomic<bool> rejected{false};
+  bool passes = false;
+  std::optional<Polytope> built;
+  std::exception_ptr build_error;
+  // Taken before the build may move the arrays into its result (their buffers stay).
+  const FaceCycleView cycles{p.face_begin.data(), p.corner_vertex.data(), topology.across.data()};
+  const auto check = [&] {
+    passes = geometry_passes(mesh, cycles);
+    rejected = !passes;
+  };
+  const auto build = [&] {
+    if (rejected) return;
+    try {
+      built = finish_from_halfedges(p, std::move(mesh_edge), mesh, name, FaceOrder::as_given);
+    } catch (...) {
+      build_error = std::current_exception();
+    }
+  };
+  if (p.num_faces() >= kParallelOperandFaces && tbb::this_task_arena::max_concurrency() > 1) {
+    run_both(build, check);
+  } else {
+    check();
+    build();
+  }
+  if (!passes) return std::nullopt;
+  if (build_error) std::rethrow_exception(build_error);
+  return built;
 }
 
 }  // namespace
@@ -1025,7 +1064,7 @@ Polytope make_polytope(const Mesh& mesh, const char* name, FaceOrder order) {
   Polytope p;
   copy_points(p, mesh);
   std::vector<int> mesh_edge = connectivity_from_halfedges(p, mesh, order);
-  return finish_from_halfedges(std::move(p), std::move(mesh_edge), mesh, name, order);
+  return finish_from_halfedges(p, std::move(mesh_edge), mesh, name, order);
 }
 
 Polytope make_operand(const Mesh& mesh, const char* name) {

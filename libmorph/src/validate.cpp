@@ -52,17 +52,18 @@ std::string number(double value) {
 // so each array is looked up once here. Element counts include deleted elements, which
 // the checks skip exactly as OpenMesh's iterators do.
 struct MeshView {
-  explicit MeshView(const Mesh& m)
+  // `none_deleted`: the caller knows that no element is deleted (skips the status scans).
+  explicit MeshView(const Mesh& m, bool none_deleted = false)
       : mesh(m),
         points(m.points()),
         n_vertices(static_cast<int>(m.n_vertices())),
         n_edges(static_cast<int>(m.n_edges())),
         n_halfedges(static_cast<int>(m.n_halfedges())),
         n_faces(static_cast<int>(m.n_faces())),
-        vertex_status(deleted_status(m, m.vertex_status_pph())),
-        edge_status(deleted_status(m, m.edge_status_pph())),
-        halfedge_status(deleted_status(m, m.halfedge_status_pph())),
-        face_status(deleted_status(m, m.face_status_pph())),
+        vertex_status(none_deleted ? nullptr : deleted_status(m, m.vertex_status_pph())),
+        edge_status(none_deleted ? nullptr : deleted_status(m, m.edge_status_pph())),
+        halfedge_status(none_deleted ? nullptr : deleted_status(m, m.halfedge_status_pph())),
+        face_status(none_deleted ? nullptr : deleted_status(m, m.face_status_pph())),
         arrays(m) {}
 
   const Mesh& mesh;
@@ -383,7 +384,8 @@ bool has_equal_pair(int n, const Key& key) {
 // when the triangle fails one of the checks that reject a mesh: the general path then
 // names the problem.
 bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, double tolerance,
-                     double zero_area, bool convexity, Geometry& geometry) {
+                     double zero_area, bool convexity, const Point& centre, FanVolumes& volumes,
+                     int& non_planar_face, bool& any_reflex) {
   const int b = cycles.begin[f];
   const int* ids = cycles.vertex + b;
   const int i0 = ids[0], i1 = ids[1], i2 = ids[2];
@@ -410,24 +412,24 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, double 
   ny *= inverse;
   nz *= inverse;
   {
-    const Point& o = geometry.extent.centre;
+    const Point& o = centre;
     const double u[3] = {p2[0] - o[0], p2[1] - o[1], p2[2] - o[2]};
     const double v[3] = {p0[0] - o[0], p0[1] - o[1], p0[2] - o[2]};
     const double w[3] = {p1[0] - o[0], p1[1] - o[1], p1[2] - o[2]};
     const double six_v = (u[0] * (v[1] * w[2] - v[2] * w[1]) + u[1] * (v[2] * w[0] - v[0] * w[2])) +
                          u[2] * (v[0] * w[1] - v[1] * w[0]);
-    geometry.volumes.total += six_v;
-    geometry.volumes.absolute += std::abs(six_v);
+    volumes.total += six_v;
+    volumes.absolute += std::abs(six_v);
   }
   // height(plane, p): dot(p - centroid, normal), summed in OpenMesh's order.
   const auto height = [&](const Point& p) {
     return (p[0] - cx) * nx + (p[1] - cy) * ny + (p[2] - cz) * nz;
   };
-  if (geometry.non_planar_face < 0 &&
+  if (non_planar_face < 0 &&
       !(std::abs(height(p0)) <= tolerance && std::abs(height(p1)) <= tolerance &&
         std::abs(height(p2)) <= tolerance))
-    geometry.non_planar_face = f;
-  if (!convexity || geometry.reflex) return true;
+    non_planar_face = f;
+  if (!convexity || any_reflex) return true;
   // The corner of each neighbouring triangle off the common edge from -> to (the edge that
   // ends at corner k); a neighbour that is not a triangle is checked after.
   const int* across = cycles.across + b;
@@ -452,7 +454,7 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, double 
       if (cycles.degree(across[k]) != 3)
         reflex = reflex_across(m, cycles, plane, across[k], from[k], to[k], tolerance);
   }
-  geometry.reflex = reflex;
+  any_reflex = reflex;
   return true;
 }
 
@@ -477,10 +479,16 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
   const double tolerance = relative_tolerance * diagonal;
   if (!geometry.cycles.begin) geometry.cycles = face_cycles(m);  // unless the caller's
   const double zero_area = kZeroAreaRatio * diagonal * diagonal;
+  // What the faces accumulate, kept in locals through the loop and stored at its end.
+  FanVolumes volumes = geometry.volumes;
+  int non_planar_face = geometry.non_planar_face;
+  bool reflex = geometry.reflex;
+  const Point centre = geometry.extent.centre;
   for (int f = 0; f < m.n_faces; ++f) {
     if (!m.live_face(f)) continue;
     const int n = geometry.cycles.degree(f);
-    if (n == 3 && triangle_passes(m, geometry.cycles, f, tolerance, zero_area, convexity, geometry))
+    if (n == 3 && triangle_passes(m, geometry.cycles, f, tolerance, zero_area, convexity, centre,
+                                  volumes, non_planar_face, reflex))
       continue;
     const int* ids = geometry.cycles.corners(f);
     const auto face = [&] { return "face " + std::to_string(f); };
@@ -501,16 +509,19 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
     if (!(length > zero_area))
       return fail(Verdict::invalid, face() + " has zero area (its vertices are collinear)");
     plane.normal *= 1.0 / length;
-    geometry.volumes.add_face(m.points, ids, n, geometry.extent.centre);
-    for (int k = 0; k < n && geometry.non_planar_face < 0; ++k)
-      if (!(std::abs(height(plane, m.points[ids[k]])) <= tolerance)) geometry.non_planar_face = f;
-    if (convexity && !geometry.reflex) {
+    volumes.add_face(m.points, ids, n, centre);
+    for (int k = 0; k < n && non_planar_face < 0; ++k)
+      if (!(std::abs(height(plane, m.points[ids[k]])) <= tolerance)) non_planar_face = f;
+    if (convexity && !reflex) {
       const int* across = geometry.cycles.across + geometry.cycles.begin[f];
-      for (int k = 0; k < n && !geometry.reflex; ++k)
-        geometry.reflex = reflex_across(m, geometry.cycles, plane, across[k],
-                                        ids[k == 0 ? n - 1 : k - 1], ids[k], tolerance);
+      for (int k = 0; k < n && !reflex; ++k)
+        reflex = reflex_across(m, geometry.cycles, plane, across[k], ids[k == 0 ? n - 1 : k - 1],
+                               ids[k], tolerance);
     }
   }
+  geometry.volumes = volumes;
+  geometry.non_planar_face = non_planar_face;
+  geometry.reflex = reflex;
   return {};
 }
 
@@ -653,7 +664,7 @@ std::optional<PreparedMesh> check_operand(const Mesh& mesh, std::string_view nam
 bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles, double planarity_tolerance) {
   // convex_polyhedron() after closed_manifold(), on the caller's cycles: the same checks on
   // the same values, without building the messages of a failure.
-  const MeshView m(mesh);
+  const MeshView m(mesh, true);  // the caller's precondition
   Geometry geometry;
   geometry.cycles.begin = cycles.begin;
   geometry.cycles.vertex = cycles.vertex;
