@@ -303,6 +303,163 @@ TEST_CASE("polytope: make_operand, which builds while it checks, keeps the check
   }
 }
 
+namespace {
+
+// make_operand, which checks and builds a mesh that passes as it is in one pass over its
+// halfedges (with the check's topology read off the build's walks), must give what the
+// check followed by the build gives: the check's message, or else the build's polytope
+// (of the reversed mesh when the check flips it) or error.
+void check_operand_agrees(const Mesh& mesh, const std::string& what) {
+  CAPTURE(what);
+  std::string expected;
+  Polytope reference;
+  try {
+    const bool flipped = !morph::prepare_convex_polyhedron(mesh, "A").notes.empty();
+    reference = morph::detail::make_polytope(mesh, "A",
+                                             flipped ? FaceOrder::reversed : FaceOrder::as_given);
+  } catch (const std::exception& error) {
+    expected = error.what();
+  }
+  try {
+    const Polytope p = morph::detail::make_operand(mesh, "A");
+    CHECK(expected == "");
+    CHECK(difference(p, reference) == "");
+  } catch (const std::exception& error) {
+    CHECK(std::string(error.what()) == expected);
+  }
+}
+
+// The unit cube [0,1]^3 (corner i at (i&1, i>>1&1, i>>2&1)) in quads, and in triangles.
+const std::vector<std::vector<int>> kQuads = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                              {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+
+std::vector<std::vector<int>> split_quads() {
+  std::vector<std::vector<int>> triangles;
+  for (const auto& q : kQuads) {
+    triangles.push_back({q[0], q[1], q[2]});
+    triangles.push_back({q[0], q[2], q[3]});
+  }
+  return triangles;
+}
+
+std::vector<Point> unit_cube_points() {
+  std::vector<Point> points;
+  for (int i = 0; i < 8; ++i) points.push_back(Point(i & 1, (i >> 1) & 1, (i >> 2) & 1));
+  return points;
+}
+
+}  // namespace
+
+TEST_CASE("polytope: make_operand's one-pass check gives the check's verdicts") {
+  const std::vector<Point> cube = unit_cube_points();
+  SUBCASE("topology: disconnected, genus 1, open, isolated vertex, deleted face, empty") {
+    std::vector<Point> two = cube;
+    std::vector<std::vector<int>> faces = kQuads;
+    for (const auto& p : cube) two.push_back(p + Point(3, 0, 0));
+    for (auto f : kQuads) {
+      for (int& i : f) i += 8;
+      faces.push_back(f);
+    }
+    check_operand_agrees(morph::test::mesh_from_polygons(two, faces), "two cubes");
+    std::vector<Point> ring;  // 4 x 4 quads on a torus of radii 3 and 1
+    std::vector<std::vector<int>> torus;
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) {
+        const double u = M_PI / 2 * i, v = M_PI / 2 * j;
+        ring.emplace_back((3 + std::cos(v)) * std::cos(u), (3 + std::cos(v)) * std::sin(u),
+                          std::sin(v));
+        torus.push_back({4 * i + j, 4 * ((i + 1) % 4) + j, 4 * ((i + 1) % 4) + (j + 1) % 4,
+                         4 * i + (j + 1) % 4});
+      }
+    check_operand_agrees(morph::test::mesh_from_polygons(ring, torus), "torus");
+    const std::vector<std::vector<int>> open(kQuads.begin(), kQuads.end() - 1);
+    check_operand_agrees(morph::test::mesh_from_polygons(cube, open), "open box");
+    Mesh lonely = morph::test::mesh_from_polygons(cube, kQuads);
+    lonely.add_vertex(Point(5, 5, 5));
+    check_operand_agrees(lonely, "isolated vertex");
+    Mesh deleted = morph::test::mesh_from_polygons(cube, kQuads);
+    deleted.delete_face(*deleted.faces().begin(), false);
+    check_operand_agrees(deleted, "deleted face");
+    check_operand_agrees(Mesh(), "empty");
+    // Two tetrahedra sharing a vertex: OpenMesh refuses the face that would close the
+    // second fan, leaving it open.
+    Mesh bow;
+    std::vector<Mesh::VertexHandle> v;
+    for (const Point& p : std::vector<Point>{
+             {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {-1, 0, 0}, {0, -1, 0}, {0, 0, -1}})
+      v.push_back(bow.add_vertex(p));
+    for (const auto& t : std::vector<std::vector<int>>{{0, 2, 1},
+                                                       {0, 4, 5},
+                                                       {0, 1, 3},
+                                                       {0, 6, 4},
+                                                       {0, 3, 2},
+                                                       {0, 5, 6},
+                                                       {1, 2, 3},
+                                                       {4, 6, 5}})
+      bow.add_face(v[t[0]], v[t[1]], v[t[2]]);
+    check_operand_agrees(bow, "bow tie");
+  }
+  SUBCASE("geometry: flat, inverted, non-finite, out of range") {
+    std::vector<Point> flat = cube;
+    for (auto& p : flat) p[2] = 0;
+    check_operand_agrees(morph::test::mesh_from_polygons(flat, split_quads()), "flat");
+    std::vector<std::vector<int>> inside_out;
+    for (const auto& t : split_quads()) inside_out.push_back({t[2], t[1], t[0]});
+    check_operand_agrees(morph::test::mesh_from_polygons(cube, inside_out), "inverted");
+    std::vector<Point> nan = cube;
+    nan[3][1] = std::nan("");
+    check_operand_agrees(morph::test::mesh_from_polygons(nan, kQuads), "not finite");
+    for (const double s : {1e-81, 1e81, 0x1p-200, 0x1p200})
+      check_operand_agrees(morph::test::scaled(morph::test::mesh_from_polygons(cube, kQuads), s),
+                           "scaled " + std::to_string(s));
+  }
+  SUBCASE("near the tolerance: bent quads and triangles, dents and ridges") {
+    // Vertex 7 (a corner of three quads) moved along z by +-2^-k: the quads bend out of
+    // plane (rejected beyond the tolerance), the triangles' edges turn reflex or convex;
+    // the range spans the tolerance (1e-9 of the diagonal) both ways.
+    for (int k = 20; k <= 40; ++k)
+      for (const double sign : {1.0, -1.0}) {
+        std::vector<Point> bent = cube;
+        bent[7][2] += sign * std::ldexp(1.0, -k);
+        const std::string what = "2^-" + std::to_string(k) + (sign > 0 ? " out" : " in");
+        check_operand_agrees(morph::test::mesh_from_polygons(bent, kQuads), "quads " + what);
+        check_operand_agrees(morph::test::mesh_from_polygons(bent, split_quads()),
+                             "triangles " + what);
+        // Far from the origin the same bends round to other heights.
+        check_operand_agrees(
+            morph::test::translated(morph::test::mesh_from_polygons(bent, split_quads()),
+                                    Point(1e6, -3e5, 2e6)),
+            "shifted triangles " + what);
+      }
+  }
+  SUBCASE("a mesh large enough to check beside the build, with one thread or two") {
+    const Mesh sphere = morph::read_mesh(std::string(MORPH_SAMPLES_DIR) + "/icosphere_1280.off");
+    REQUIRE(sphere.n_faces() >= 1000);
+    for (int threads : {1, 2}) {
+      CAPTURE(threads);
+      tbb::task_arena arena(threads);
+      arena.execute([&] {
+        check_operand_agrees(sphere, "sphere");
+        for (const double s : {0.9, 1 - 1e-12, 1 + 1e-12, 1.1}) {
+          Mesh bent = sphere;
+          bent.set_point(Mesh::VertexHandle(0), sphere.point(Mesh::VertexHandle(0)) * s);
+          check_operand_agrees(bent, "vertex 0 scaled by " + std::to_string(s));
+        }
+      });
+    }
+  }
+  SUBCASE("random polytopes, scaled and shifted") {
+    for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+      const Mesh sphere = morph::test::random_sphere_polytope(80, seed);
+      check_operand_agrees(sphere, "sphere");
+      check_operand_agrees(morph::test::scaled(sphere, 0x1p-200), "sphere 2^-200");
+      check_operand_agrees(morph::test::scaled(sphere, 0x1p200), "sphere 2^200");
+      check_operand_agrees(morph::test::translated(sphere, Point(1e9, 0, -1e9)), "far sphere");
+      check_operand_agrees(morph::test::random_integer_polytope(40, seed), "integer");
+    }
+  }
+}
+
 TEST_CASE("polytope: two triangles a hair from coplanar stay apart when convex, merge when not") {
   // The unit cube in triangles; its bottom quad 0-2-3-1 (z = 0) is split along 0-3. Moving
   // vertex 0 by eps along -z keeps its side faces in their planes and bends the bottom

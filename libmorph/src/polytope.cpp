@@ -10,6 +10,7 @@
 #include <exception>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <string>
 #include <unordered_map>
 
@@ -198,6 +199,19 @@ UnitNormal unit_newell(const std::vector<V3<double>>& points, const int* corners
   const V3<double>& o = points[corners[0]];
   V3<double> sum{0, 0, 0}, magnitude{0, 0, 0};
   V3<double> a = points[corners[1]] - o;
+  if (d == 3) {
+    // The loop below run once, written out (most facets are triangles): the same values.
+    const V3<double> b = points[corners[2]] - o;
+    const double xy = a.y * b.z, xz = a.z * b.y, yz = a.z * b.x, yx = a.x * b.z, zx = a.x * b.y,
+                 zy = a.y * b.x;
+    sum = {0.0 + (xy - xz), 0.0 + (yz - yx), 0.0 + (zx - zy)};
+    const double factor = 5 * kUlp * 1.01, absolute = 3 * 0x1p-1000;
+    return normalised(sum, (factor * ((0.0 + (std::abs(xy) + std::abs(xz))) +
+                                      (0.0 + (std::abs(yz) + std::abs(yx))) +
+                                      (0.0 + (std::abs(zx) + std::abs(zy)))) +
+                            3 * absolute) *
+                               1.01);
+  }
   for (int k = 2; k < d; ++k) {
     const V3<double> b = points[corners[k]] - o;
     const double xy = a.y * b.z, xz = a.z * b.y, yz = a.z * b.x, yx = a.x * b.z, zx = a.x * b.y,
@@ -514,18 +528,24 @@ void check_gauss_map(const Polytope& p, const char* name) {
     if (n < 3)
       fail(name, "vertex " + std::to_string(p.vertex_source[v]) + " has fewer than three facets");
     const int* fan = &p.fan_face[b];
-    for (int i = 0, j = 1, k = 2; i < n; ++i, j = k, k = k + 1 == n ? 0 : k + 1) {
+    // Triple i is (fan[i], fan[i + 1], fan[i + 2]) cyclically: each step reads one new normal.
+    const UnitNormal *px = &unit[fan[0]], *py = &unit[fan[1]];
+    for (int i = 0; i < n; ++i) {
+      const int k = i + 2 < n ? i + 2 : i + 2 - n;
+      const UnitNormal* pz = &unit[fan[k]];
       // orient_normals' double filter, on the unit normals read straight from the array
       // (the same expression and bound); its later stages decide what it leaves.
-      const UnitNormal &x = unit[fan[i]], &y = unit[fan[j]], &z = unit[fan[k]];
+      const UnitNormal &x = *px, &y = *py, &z = *pz;
+      px = py;
+      py = pz;
       const double d = x.x * (y.y * z.z - y.z * z.y) + x.y * (y.z * z.x - y.x * z.z) +
                        x.z * (y.x * z.y - y.y * z.x);
       const double bound = x.error + y.error + z.error + kUnitPredicateRounding;
       if (d > bound) continue;
-      const int s = d < -bound
-                        ? -1
-                        : orient_normals_undecided(NormalRef{&p, fan[i]}, NormalRef{&p, fan[j]},
-                                                   NormalRef{&p, fan[k]});
+      const int s = d < -bound ? -1
+                               : orient_normals_undecided(NormalRef{&p, fan[i]},
+                                                          NormalRef{&p, fan[i + 1 < n ? i + 1 : 0]},
+                                                          NormalRef{&p, fan[k]});
       if (s <= 0)
         fail(name, "the facets around vertex " + std::to_string(p.vertex_source[v]) +
                        " do not turn convexly (the mesh is not convex)");
@@ -555,12 +575,57 @@ bool is_canonical(const Polytope& p) {
   return true;
 }
 
+/// The rest of check_operand's topological checks on a mesh whose halfedges
+/// connectivity_from_halfedges found consistent (every vertex one fan reaching each
+/// neighbour once): every vertex's halfedge leaves it (where the check's fan walk starts),
+/// the vertices are connected, and V - E + F = 2.
+bool operand_topology(const Polytope& p, const HalfedgeArrays& arrays, int nf) {
+  const int nv = p.num_vertices();
+  const int nh = static_cast<int>(p.corner_vertex.size());
+  for (int v = 0; v < nv; ++v) {
+    const int h = arrays.halfedge_of_vertex(v);
+    if (h < 0 || h >= nh || arrays.to(h ^ 1) != v) return false;
+  }
+  // A search through the fans from vertex 0, as the check's.
+  std::vector<char> reached(nv, 0);
+  std::vector<int> stack;
+  stack.reserve(nv);
+  int count = 0;
+  if (nv > 0) {
+    reached[0] = 1;
+    stack.push_back(0);
+  }
+  while (!stack.empty()) {
+    const int v = stack.back();
+    stack.pop_back();
+    ++count;
+    for (int s = p.fan_begin[v]; s < p.fan_begin[v + 1]; ++s) {
+      const int w = p.fan_vertex[s];
+      if (reached[w]) continue;
+      reached[w] = 1;
+      stack.push_back(w);
+    }
+  }
+  return count == nv && static_cast<long long>(nv) - nh / 2 + nf == 2;
+}
+
+/// What make_operand's checked path (checked_polytope) reads off the halfedges beside the
+/// polytope's connectivity: the face across the edge that ends at each corner (check_operand's
+/// face cycles, see FaceCycleView), and whether the mesh passes check_operand's topological
+/// checks.
+struct OperandTopology {
+  std::vector<int> across;
+  bool passes = false;
+};
+
 /// Faces, edges and fans of `p` straight from the halfedges of `mesh` (closed, manifold,
 /// no deleted elements), each facet reversed if `order` says so. The numbering is the one
 /// build_connectivity gives the mesh's face cycles: facets in face order, corners from the
 /// face circulator's first vertex, edges in order of first use. Returns the mesh edge of
-/// each polytope edge.
-std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, FaceOrder order) {
+/// each polytope edge. With `topology` (as given only), also tells whether check_operand's
+/// topological checks pass, from what the walks read anyway (see checked_polytope).
+std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, FaceOrder order,
+                                             OperandTopology* topology = nullptr) {
   const int nv = static_cast<int>(mesh.n_vertices());
   const int nf = static_cast<int>(mesh.n_faces());
   const int nh = static_cast<int>(mesh.n_halfedges());
@@ -578,27 +643,43 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   std::unique_ptr<FanLink[]> link(new FanLink[nh]);
   p.face_begin.resize(nf + 1);
   p.corner_vertex.resize(nh);
+  const HalfedgeArrays arrays(mesh);
+  // The checked path's findings: whether every halfedge names the face whose cycle holds
+  // it and its opposite ends at the corner's vertex (the check reads both), and `across`.
+  bool consistent = true;
+  int* across = nullptr;
+  if (topology) {
+    topology->passes = false;
+    topology->across.resize(nh);
+    across = topology->across.data();
+  }
   int c = 0;
   for (int f = 0; f < nf; ++f) {
     p.face_begin[f] = c;
-    const auto h0 = mesh.halfedge_handle(Mesh::FaceHandle(f));
+    const int h0 = arrays.halfedge_of_face(f);
     // The face circulator starts at the target of h0. As given, a corner's vertex is the
     // target of the halfedge before it (read with the link to the next one).
-    const auto start = reversed ? mesh.prev_halfedge_handle(h0) : mesh.next_halfedge_handle(h0);
-    int from = mesh.to_vertex_handle(h0).idx();
-    auto h = start;
+    const int start = reversed ? arrays.prev(h0) : arrays.next(h0);
+    int from = arrays.to(h0);
+    int entering = h0;  // the halfedge that ends at the corner (as given)
+    int h = start;
     do {
       // Each halfedge once: with the count below, every halfedge is some face's.
-      if (c == nh || corner_of[h.idx()] >= 0)
+      if (c == nh || corner_of[h] >= 0)
         throw error("internal error: a mesh face is not a closed cycle");
-      p.corner_vertex[c] = reversed ? mesh.to_vertex_handle(h).idx() : from;
-      corner_halfedge[c] = h.idx();
+      p.corner_vertex[c] = reversed ? arrays.to(h) : from;
+      corner_halfedge[c] = h;
       link[c].face = f;
       link[c].prev = c - 1;
-      corner_of[h.idx()] = c;
+      corner_of[h] = c;
+      if (topology) {
+        across[c] = arrays.face(entering ^ 1);
+        consistent = consistent && arrays.face(h) == f && arrays.to(h ^ 1) == from;
+        entering = h;
+      }
       ++c;
-      if (!reversed) from = mesh.to_vertex_handle(h).idx();
-      h = reversed ? mesh.prev_halfedge_handle(h) : mesh.next_halfedge_handle(h);
+      if (!reversed) from = arrays.to(h);
+      h = reversed ? arrays.prev(h) : arrays.next(h);
     } while (h != start);
     link[p.face_begin[f]].prev = c - 1;
   }
@@ -614,46 +695,63 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   // counter-clockwise is across the incoming edge u -> v, at corner twin(prev corner),
   // precomputed so that the fan walk below follows one link per step, as
   // build_connectivity walks them) and the last corner at each vertex, where its fan starts.
-  std::vector<int> mesh_edge;
-  mesh_edge.reserve(mesh.n_edges());
-  p.edges.clear();
-  p.edges.reserve(mesh.n_edges());
+  // Each edge has two corners (every halfedge is one face's): nc / 2 edges, written by index.
+  const int ne = nc / 2;
+  std::vector<int> mesh_edge(ne);
+  p.edges.resize(ne);
   p.corner_edge.resize(nc);
   std::vector<int> some_corner(nv, -1);
-  for (c = 0; c < nc; ++c) {
-    FanLink& l = link[c];
-    l.next = twin(l.prev);
-    some_corner[p.corner_vertex[c]] = c;
-    const int t = twin(c);
-    if (t < c) continue;  // numbered at t
-    const int e = static_cast<int>(p.edges.size());
-    p.edges.push_back({p.corner_vertex[c], p.corner_vertex[t], l.face, link[t].face});
-    mesh_edge.push_back(corner_halfedge[c] >> 1);
-    p.corner_edge[c] = e;
-    p.corner_edge[t] = e;
+  int e = 0;
+  for (int f = 0; f < nf; ++f) {
+    const int begin = p.face_begin[f], end = p.face_begin[f + 1];
+    for (c = begin; c < end; ++c) {
+      const int t = twin(c);
+      // c is the previous corner of the facet's next one, whose fan link is twin(c).
+      link[c + 1 == end ? begin : c + 1].next = t;
+      some_corner[p.corner_vertex[c]] = c;
+      if (t < c) continue;  // numbered at t
+      if (e == ne) throw error("internal error: a mesh edge has one face");
+      p.edges[e] = {p.corner_vertex[c], p.corner_vertex[t], f, link[t].face};
+      mesh_edge[e] = corner_halfedge[c] >> 1;
+      p.corner_edge[c] = e;
+      p.corner_edge[t] = e;
+      ++e;
+    }
   }
   p.fan_begin.resize(nv + 1);
   p.fan_face.resize(nc);
   p.fan_edge.resize(nc);
   p.fan_vertex.resize(nc);
   int slot = 0;
+  // The checked path: the vertex whose fan last reached each vertex (a neighbour reached
+  // twice means two edges between the same vertices).
+  std::vector<int> seen(topology ? nv : 0, -1);
   for (int v = 0; v < nv; ++v) {
     p.fan_begin[v] = slot;
     const int first = some_corner[v];
-    if (first < 0) continue;
+    if (first < 0) {
+      consistent = false;  // isolated
+      continue;
+    }
     c = first;
     do {
       if (slot == nc) throw error("internal error: a mesh vertex has a broken fan");
       const FanLink& l = link[c];
       p.fan_face[slot] = l.face;
       p.fan_edge[slot] = p.corner_edge[l.prev];
-      p.fan_vertex[slot] = p.corner_vertex[l.prev];
+      const int w = p.corner_vertex[l.prev];
+      p.fan_vertex[slot] = w;
+      if (topology) {
+        consistent = consistent && seen[w] != v;
+        seen[w] = v;
+      }
       ++slot;
       c = l.next;
     } while (c != first);
   }
   p.fan_begin[nv] = slot;
   if (slot != nc) throw error("internal error: a mesh vertex has several fans");
+  if (topology && consistent) topology->passes = operand_topology(p, arrays, nf);
   return mesh_edge;
 }
 
@@ -874,13 +972,13 @@ Polytope make_polytope_from_cycles(const Mesh& mesh, const char* name, FaceOrder
   return p;
 }
 
-Polytope make_polytope(const Mesh& mesh, const char* name, FaceOrder order) {
-  if (has_deleted_elements(mesh)) return make_polytope_from_cycles(mesh, name, order);
-  Polytope p;
-  p.points.resize(mesh.n_vertices());
-  const Point* q = mesh.points();
-  for (int v = 0; v < p.num_vertices(); ++v) p.points[v] = {q[v][0], q[v][1], q[v][2]};
-  std::vector<int> mesh_edge = connectivity_from_halfedges(p, mesh, order);
+namespace {
+
+/// make_polytope(mesh, name, order) once connectivity_from_halfedges has filled p's facets,
+/// edges and fans: the normals, the canonical form, the labels and the Gauss map. The facet
+/// cycles are only read (they end in the result, or stay in p).
+Polytope finish_from_halfedges(Polytope& p, std::vector<int> mesh_edge, const Mesh& mesh,
+                               const char* name, FaceOrder order) {
   p.compute_normals();
   if (!is_canonical(p)) return make_polytope_from_cycles(mesh, name, order);
   p.vertex_source.resize(p.num_vertices());
@@ -890,16 +988,94 @@ Polytope make_polytope(const Mesh& mesh, const char* name, FaceOrder order) {
   p.edge_source = std::move(mesh_edge);
   // Every edge is strictly convex (is_canonical); the Gauss map is left to check.
   check_gauss_map(p, name);
-  return p;
+  return std::move(p);
+}
+
+// Below this many facets, checked_polytope checks and builds in sequence even when threads
+// allow: waking a worker costs more than the shorter of the two halves.
+constexpr int kParallelOperandFaces = 1000;
+
+void copy_points(Polytope& p, const Mesh& mesh) {
+  p.points.resize(mesh.n_vertices());
+  const Point* q = mesh.points();
+  for (int v = 0; v < p.num_vertices(); ++v) p.points[v] = {q[v][0], q[v][1], q[v][2]};
+}
+
+/// make_operand(mesh, name) in one pass for a mesh that is an operand as it is (the usual
+/// case): the halfedge walks that build the polytope also find whether check_operand's
+/// topological checks pass, and its geometric checks then run on the polytope's facet cycles
+/// (geometry_passes), so the mesh's connectivity is read once. Returns nothing when the check
+/// would not pass the mesh as it is (an error, an inverted mesh, a deleted element) or the
+/// walks meet anything unusual: make_operand then checks and builds as before, for the same
+/// messages. The polytope is make_polytope(mesh, name)'s, built by the same code.
+std::optional<Polytope> checked_polytope(const Mesh& mesh, const char* name) {
+  if (mesh.n_faces() == 0 || has_deleted_elements(mesh) || !readable(mesh)) return std::nullopt;
+  if (mesh.has_halfedge_status()) {  // the check counts only live halfedges
+    const auto& status = mesh.property(mesh.halfedge_status_pph()).data_vector();
+    if (std::any_of(status.begin(), status.end(), [](const auto& s) { return s.deleted(); }))
+      return std::nullopt;
+  }
+  Polytope p;
+  copy_points(p, mesh);
+  OperandTopology topology;
+  std::vector<int> mesh_edge;
+  try {
+    mesh_edge = connectivity_from_halfedges(p, mesh, FaceOrder::as_given, &topology);
+  } catch (const error&) {  // a broken face cycle or fan: the check names it
+    return std::nullopt;
+  }
+  if (!topology.passes) return std::nullopt;
+  // The geometric checks and the rest of the build both only read the facet cycles: beside
+  // each other when threads allow, the build first in the order given to run_both, and with
+  // one thread the check first. The check's verdict decides, as in make_operand.
+  std::atomic<bool> rejected{false};
+  bool passes = false;
+  std::optional<Polytope> built;
+  std::exception_ptr build_error;
+  // Taken before the build may move the arrays into its result (their buffers stay).
+  const FaceCycleView cycles{p.face_begin.data(), p.corner_vertex.data(), topology.across.data()};
+  const auto check = [&] {
+    passes = geometry_passes(mesh, cycles);
+    rejected = !passes;
+  };
+  const auto build = [&] {
+    if (rejected) return;
+    try {
+      built = finish_from_halfedges(p, std::move(mesh_edge), mesh, name, FaceOrder::as_given);
+    } catch (...) {
+      build_error = std::current_exception();
+    }
+  };
+  if (p.num_faces() >= kParallelOperandFaces && tbb::this_task_arena::max_concurrency() > 1) {
+    run_both(build, check);
+  } else {
+    check();
+    build();
+  }
+  if (!passes) return std::nullopt;
+  if (build_error) std::rethrow_exception(build_error);
+  return built;
+}
+
+}  // namespace
+
+Polytope make_polytope(const Mesh& mesh, const char* name, FaceOrder order) {
+  if (has_deleted_elements(mesh)) return make_polytope_from_cycles(mesh, name, order);
+  Polytope p;
+  copy_points(p, mesh);
+  std::vector<int> mesh_edge = connectivity_from_halfedges(p, mesh, order);
+  return finish_from_halfedges(p, std::move(mesh_edge), mesh, name, order);
 }
 
 Polytope make_operand(const Mesh& mesh, const char* name) {
-  // The polytope is built while the mesh is checked (on another thread when there is one),
-  // as if the mesh were valid and outward: its halfedges are read before the check has
-  // passed, which is safe once every coordinate is finite (all make_polytope's other
-  // assumptions, a closed mesh first, are tested as it goes, or only make it throw). The
-  // check's verdict decides: its error wins, an inverted mesh is built again reversed, and
-  // otherwise the build's result (or error) is the one the sequential order would give.
+  if (std::optional<Polytope> p = checked_polytope(mesh, name)) return std::move(*p);
+  // Anything else (an error, an inverted mesh, deleted elements): the polytope is built while the
+  // mesh is checked (on another thread when there is one), as if the mesh were valid and outward:
+  // its halfedges are read before the check has passed, which is safe once every coordinate is
+  // finite (all make_polytope's other assumptions, a closed mesh first, are tested as it goes, or
+  // only make it throw). The check's verdict decides: its error wins, an inverted mesh is built
+  // again reversed, and otherwise the build's result (or error) is the one the sequential order
+  // would give.
   std::atomic<bool> rejected{false};
   bool inverted = false, built = false;
   Polytope p;

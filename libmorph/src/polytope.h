@@ -288,8 +288,10 @@ Polytope make_polytope(std::vector<V3<double>> points, ExactPoints exact_points,
                        std::vector<V3<ExactN>> given_normals, const char* name);
 
 /// An operand: checks `mesh` with prepare_convex_polyhedron (throwing invalid_mesh /
-/// not_convex prefixed with `name`, flipping a fully inverted mesh) and builds its polytope,
-/// the build beside the check when threads allow (same result and errors as in sequence).
+/// not_convex prefixed with `name`, flipping a fully inverted mesh) and builds its polytope.
+/// A mesh that passes as it is is checked and built in one pass over its halfedges; any
+/// other is checked with the build beside it when threads allow (same result and errors as
+/// in sequence).
 Polytope make_operand(const Mesh& mesh, const char* name);
 
 /// make_operand(A, "A") and make_operand(B, "B"), side by side when threads allow; A's

@@ -52,17 +52,19 @@ std::string number(double value) {
 // so each array is looked up once here. Element counts include deleted elements, which
 // the checks skip exactly as OpenMesh's iterators do.
 struct MeshView {
-  explicit MeshView(const Mesh& m)
+  // `none_deleted`: the caller knows that no element is deleted (skips the status scans).
+  explicit MeshView(const Mesh& m, bool none_deleted = false)
       : mesh(m),
         points(m.points()),
         n_vertices(static_cast<int>(m.n_vertices())),
         n_edges(static_cast<int>(m.n_edges())),
         n_halfedges(static_cast<int>(m.n_halfedges())),
         n_faces(static_cast<int>(m.n_faces())),
-        vertex_status(deleted_status(m, m.vertex_status_pph())),
-        edge_status(deleted_status(m, m.edge_status_pph())),
-        halfedge_status(deleted_status(m, m.halfedge_status_pph())),
-        face_status(deleted_status(m, m.face_status_pph())) {}
+        vertex_status(none_deleted ? nullptr : deleted_status(m, m.vertex_status_pph())),
+        edge_status(none_deleted ? nullptr : deleted_status(m, m.edge_status_pph())),
+        halfedge_status(none_deleted ? nullptr : deleted_status(m, m.halfedge_status_pph())),
+        face_status(none_deleted ? nullptr : deleted_status(m, m.face_status_pph())),
+        arrays(m) {}
 
   const Mesh& mesh;
   const Point* points;
@@ -70,6 +72,7 @@ struct MeshView {
   // Null when no element of that kind is deleted (or the kind has no status).
   const OpenMesh::Attributes::StatusInfo *vertex_status, *edge_status, *halfedge_status,
       *face_status;
+  detail::HalfedgeArrays arrays;
 
   template <class StatusHandle>
   static const OpenMesh::Attributes::StatusInfo* deleted_status(const Mesh& m,
@@ -87,12 +90,12 @@ struct MeshView {
   bool live_face(int f) const { return !face_status || !face_status[f].deleted(); }
 
   // OpenMesh stores the two halfedges of edge e as 2e and 2e + 1.
-  int to(int h) const { return mesh.to_vertex_handle(Mesh::HalfedgeHandle(h)).idx(); }
-  int from(int h) const { return to(h ^ 1); }
-  int next(int h) const { return mesh.next_halfedge_handle(Mesh::HalfedgeHandle(h)).idx(); }
-  int face(int h) const { return mesh.face_handle(Mesh::HalfedgeHandle(h)).idx(); }
-  int halfedge_of_vertex(int v) const { return mesh.halfedge_handle(Mesh::VertexHandle(v)).idx(); }
-  int halfedge_of_face(int f) const { return mesh.halfedge_handle(Mesh::FaceHandle(f)).idx(); }
+  int to(int h) const { return arrays.to(h); }
+  int from(int h) const { return arrays.from(h); }
+  int next(int h) const { return arrays.next(h); }
+  int face(int h) const { return arrays.face(h); }
+  int halfedge_of_vertex(int v) const { return arrays.halfedge_of_vertex(v); }
+  int halfedge_of_face(int f) const { return arrays.halfedge_of_face(f); }
 };
 
 std::string vertex_pair(const MeshView& m, int edge) {
@@ -123,24 +126,31 @@ Extent bounding_box(const MeshView& m) {
 // at the target of the face's halfedge), read once for all the geometric checks. A
 // deleted face has an empty cycle.
 struct FaceCycles {
-  std::vector<int> begin;   // size F + 1, over all faces
-  std::vector<int> vertex;  // corner k of face f: vertex[begin[f] + k]
-  std::vector<int> across;  // the face across the edge that ends at corner k (if any)
+  FaceCycles() = default;
+  FaceCycles(FaceCycles&&) = default;  // the arrays keep their buffers
+  FaceCycles& operator=(FaceCycles&&) = default;
+  // Over all faces: begin has size F + 1; corner k of face f is vertex[begin[f] + k], and
+  // across[begin[f] + k] the face across the edge that ends at it (if any). Either the
+  // stores below (face_cycles()) or a caller's arrays (detail::FaceCycleView).
+  const int* begin = nullptr;
+  const int* vertex = nullptr;
+  const int* across = nullptr;
+  std::vector<int> begin_store, vertex_store, across_store;
   int degree(int f) const { return begin[f + 1] - begin[f]; }
-  const int* corners(int f) const { return vertex.data() + begin[f]; }
+  const int* corners(int f) const { return vertex + begin[f]; }
 };
 
 FaceCycles face_cycles(const MeshView& m) {
   FaceCycles cycles;
-  cycles.begin.resize(m.n_faces + 1);
+  cycles.begin_store.resize(m.n_faces + 1);
   // At most one corner per halfedge: written by index, trimmed at the end.
-  cycles.vertex.resize(m.n_halfedges);
-  cycles.across.resize(m.n_halfedges);
-  int* const vertex = cycles.vertex.data();
-  int* const across = cycles.across.data();
+  cycles.vertex_store.resize(m.n_halfedges);
+  cycles.across_store.resize(m.n_halfedges);
+  int* const vertex = cycles.vertex_store.data();
+  int* const across = cycles.across_store.data();
   int c = 0;
   for (int f = 0; f < m.n_faces; ++f) {
-    cycles.begin[f] = c;
+    cycles.begin_store[f] = c;
     if (!m.live_face(f)) continue;
     const int first = m.halfedge_of_face(f);
     int h = first;
@@ -154,9 +164,10 @@ FaceCycles face_cycles(const MeshView& m) {
       h = m.next(h);
     } while (h != first);
   }
-  cycles.begin[m.n_faces] = c;
-  cycles.vertex.resize(c);
-  cycles.across.resize(c);
+  cycles.begin_store[m.n_faces] = c;
+  cycles.begin = cycles.begin_store.data();
+  cycles.vertex = vertex;
+  cycles.across = across;
   return cycles;
 }
 
@@ -373,87 +384,77 @@ bool has_equal_pair(int n, const Key& key) {
 // when the triangle fails one of the checks that reject a mesh: the general path then
 // names the problem.
 bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, double tolerance,
-                     double zero_area, bool convexity, Geometry& geometry) {
-  const int* ids = cycles.corners(f);
-  const int* across = cycles.across.data() + cycles.begin[f];
+                     double zero_area, bool convexity, const Point& centre, FanVolumes& volumes,
+                     int& non_planar_face, bool& any_reflex) {
+  const int b = cycles.begin[f];
+  const int* ids = cycles.vertex + b;
   const int i0 = ids[0], i1 = ids[1], i2 = ids[2];
   if (i0 == i1 || i0 == i2 || i1 == i2) return false;
   const Point &p0 = m.points[i0], &p1 = m.points[i1], &p2 = m.points[i2];
-  // In plain doubles: OpenMesh's vector operations, one component at a time.
-  double c[3], normal[3];
-  for (int i = 0; i < 3; ++i) c[i] = (((0.0 + p0[i]) + p1[i]) + p2[i]) * (1.0 / 3);
-  double a[3][3];  // the corners relative to the centroid
-  for (int i = 0; i < 3; ++i) {
-    a[0][i] = p0[i] - c[i];
-    a[1][i] = p1[i] - c[i];
-    a[2][i] = p2[i] - c[i];
-  }
-  // cross(u, v) component i: u[j] v[l] - u[l] v[j] with (j, l) = (i + 1, i + 2) mod 3.
-  for (int i = 0; i < 3; ++i) {
-    const int j = (i + 1) % 3, l = (i + 2) % 3;
-    normal[i] = ((0.0 + (a[0][j] * a[1][l] - a[0][l] * a[1][j])) +
-                 (a[1][j] * a[2][l] - a[1][l] * a[2][j])) +
-                (a[2][j] * a[0][l] - a[2][l] * a[0][j]);
-  }
+  // In plain doubles, straight-line: OpenMesh's vector operations, one component at a time.
+  const double cx = (((0.0 + p0[0]) + p1[0]) + p2[0]) * (1.0 / 3);
+  const double cy = (((0.0 + p0[1]) + p1[1]) + p2[1]) * (1.0 / 3);
+  const double cz = (((0.0 + p0[2]) + p1[2]) + p2[2]) * (1.0 / 3);
+  // The corners relative to the centroid.
+  const double ax = p0[0] - cx, ay = p0[1] - cy, az = p0[2] - cz;
+  const double bx = p1[0] - cx, by = p1[1] - cy, bz = p1[2] - cz;
+  const double qx = p2[0] - cx, qy = p2[1] - cy, qz = p2[2] - cz;
+  // cross(u, v) component i: u[j] v[l] - u[l] v[j] with (j, l) = (i + 1, i + 2) mod 3,
+  // summed over the edges a-b, b-q, q-a from zero.
+  double nx = ((0.0 + (ay * bz - az * by)) + (by * qz - bz * qy)) + (qy * az - qz * ay);
+  double ny = ((0.0 + (az * bx - ax * bz)) + (bz * qx - bx * qz)) + (qz * ax - qx * az);
+  double nz = ((0.0 + (ax * by - ay * bx)) + (bx * qy - by * qx)) + (qx * ay - qy * ax);
   if (p0 == p1 || p0 == p2 || p1 == p2) return false;
-  const double length =
-      std::sqrt((normal[0] * normal[0] + normal[1] * normal[1]) + normal[2] * normal[2]);
+  const double length = std::sqrt((nx * nx + ny * ny) + nz * nz);
   if (!(length > zero_area)) return false;
   const double inverse = 1.0 / length;
-  for (double& x : normal) x *= inverse;
+  nx *= inverse;
+  ny *= inverse;
+  nz *= inverse;
   {
-    const Point& o = geometry.extent.centre;
+    const Point& o = centre;
     const double u[3] = {p2[0] - o[0], p2[1] - o[1], p2[2] - o[2]};
     const double v[3] = {p0[0] - o[0], p0[1] - o[1], p0[2] - o[2]};
     const double w[3] = {p1[0] - o[0], p1[1] - o[1], p1[2] - o[2]};
     const double six_v = (u[0] * (v[1] * w[2] - v[2] * w[1]) + u[1] * (v[2] * w[0] - v[0] * w[2])) +
                          u[2] * (v[0] * w[1] - v[1] * w[0]);
-    geometry.volumes.total += six_v;
-    geometry.volumes.absolute += std::abs(six_v);
-  }
-  // The points whose height above the plane the checks read: the corners (planarity),
-  // then the corner of each neighbouring triangle off the common edge (convexity).
-  const bool reflex = convexity && !geometry.reflex;
-  const Point* points[6] = {&p0, &p1, &p2};
-  int count = 3;
-  bool polygon_across = false;  // a neighbour is not a triangle: checked after
-  if (reflex) {
-    const int from[3] = {i2, i0, i1}, to[3] = {i0, i1, i2};
-    for (int k = 0; k < 3; ++k) {
-      const int g = across[k];
-      if (cycles.degree(g) != 3) {
-        polygon_across = true;
-        continue;
-      }
-      const int* corners = cycles.corners(g);
-      const int v = corners[0] != from[k] && corners[0] != to[k]   ? corners[0]
-                    : corners[1] != from[k] && corners[1] != to[k] ? corners[1]
-                                                                   : corners[2];
-      points[count++] = &m.points[v];
-    }
+    volumes.total += six_v;
+    volumes.absolute += std::abs(six_v);
   }
   // height(plane, p): dot(p - centroid, normal), summed in OpenMesh's order.
-  const double nx = normal[0], ny = normal[1], nz = normal[2];
-  const double cx = c[0], cy = c[1], cz = c[2];
-  double height[6];
-  for (int k = 0; k < count; ++k) {
-    const Point& p = *points[k];
-    height[k] = (p[0] - cx) * nx + (p[1] - cy) * ny + (p[2] - cz) * nz;
-  }
-  if (geometry.non_planar_face < 0 &&
-      !(std::abs(height[0]) <= tolerance && std::abs(height[1]) <= tolerance &&
-        std::abs(height[2]) <= tolerance))
-    geometry.non_planar_face = f;
-  if (reflex) {
-    for (int k = 3; k < count; ++k) geometry.reflex = geometry.reflex || !(height[k] <= tolerance);
-    if (polygon_across && !geometry.reflex) {
-      const FacePlane plane{Point(cx, cy, cz), Point(nx, ny, nz)};
-      const int from[3] = {i2, i0, i1}, to[3] = {i0, i1, i2};
-      for (int k = 0; k < 3 && !geometry.reflex; ++k)
-        if (cycles.degree(across[k]) != 3)
-          geometry.reflex = reflex_across(m, cycles, plane, across[k], from[k], to[k], tolerance);
+  const auto height = [&](const Point& p) {
+    return (p[0] - cx) * nx + (p[1] - cy) * ny + (p[2] - cz) * nz;
+  };
+  if (non_planar_face < 0 &&
+      !(std::abs(height(p0)) <= tolerance && std::abs(height(p1)) <= tolerance &&
+        std::abs(height(p2)) <= tolerance))
+    non_planar_face = f;
+  if (!convexity || any_reflex) return true;
+  // The corner of each neighbouring triangle off the common edge from -> to (the edge that
+  // ends at corner k); a neighbour that is not a triangle is checked after.
+  const int* across = cycles.across + b;
+  const int from[3] = {i2, i0, i1}, to[3] = {i0, i1, i2};
+  bool reflex = false, polygon_across = false;
+  for (int k = 0; k < 3; ++k) {
+    const int g = across[k];
+    const int gb = cycles.begin[g];
+    if (cycles.begin[g + 1] - gb != 3) {
+      polygon_across = true;
+      continue;
     }
+    const int* corners = cycles.vertex + gb;
+    const int v = corners[0] != from[k] && corners[0] != to[k]   ? corners[0]
+                  : corners[1] != from[k] && corners[1] != to[k] ? corners[1]
+                                                                 : corners[2];
+    reflex = reflex || !(height(m.points[v]) <= tolerance);
   }
+  if (polygon_across && !reflex) {
+    const FacePlane plane{Point(cx, cy, cz), Point(nx, ny, nz)};
+    for (int k = 0; k < 3 && !reflex; ++k)
+      if (cycles.degree(across[k]) != 3)
+        reflex = reflex_across(m, cycles, plane, across[k], from[k], to[k], tolerance);
+  }
+  any_reflex = reflex;
   return true;
 }
 
@@ -476,12 +477,18 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
                                       ") is outside the supported range [" + number(kMinSize) +
                                       ", " + number(kMaxSize) + "]");
   const double tolerance = relative_tolerance * diagonal;
-  geometry.cycles = face_cycles(m);
+  if (!geometry.cycles.begin) geometry.cycles = face_cycles(m);  // unless the caller's
   const double zero_area = kZeroAreaRatio * diagonal * diagonal;
+  // What the faces accumulate, kept in locals through the loop and stored at its end.
+  FanVolumes volumes = geometry.volumes;
+  int non_planar_face = geometry.non_planar_face;
+  bool reflex = geometry.reflex;
+  const Point centre = geometry.extent.centre;
   for (int f = 0; f < m.n_faces; ++f) {
     if (!m.live_face(f)) continue;
     const int n = geometry.cycles.degree(f);
-    if (n == 3 && triangle_passes(m, geometry.cycles, f, tolerance, zero_area, convexity, geometry))
+    if (n == 3 && triangle_passes(m, geometry.cycles, f, tolerance, zero_area, convexity, centre,
+                                  volumes, non_planar_face, reflex))
       continue;
     const int* ids = geometry.cycles.corners(f);
     const auto face = [&] { return "face " + std::to_string(f); };
@@ -502,16 +509,19 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
     if (!(length > zero_area))
       return fail(Verdict::invalid, face() + " has zero area (its vertices are collinear)");
     plane.normal *= 1.0 / length;
-    geometry.volumes.add_face(m.points, ids, n, geometry.extent.centre);
-    for (int k = 0; k < n && geometry.non_planar_face < 0; ++k)
-      if (!(std::abs(height(plane, m.points[ids[k]])) <= tolerance)) geometry.non_planar_face = f;
-    if (convexity && !geometry.reflex) {
-      const int* across = geometry.cycles.across.data() + geometry.cycles.begin[f];
-      for (int k = 0; k < n && !geometry.reflex; ++k)
-        geometry.reflex = reflex_across(m, geometry.cycles, plane, across[k],
-                                        ids[k == 0 ? n - 1 : k - 1], ids[k], tolerance);
+    volumes.add_face(m.points, ids, n, centre);
+    for (int k = 0; k < n && non_planar_face < 0; ++k)
+      if (!(std::abs(height(plane, m.points[ids[k]])) <= tolerance)) non_planar_face = f;
+    if (convexity && !reflex) {
+      const int* across = geometry.cycles.across + geometry.cycles.begin[f];
+      for (int k = 0; k < n && !reflex; ++k)
+        reflex = reflex_across(m, geometry.cycles, plane, across[k], ids[k == 0 ? n - 1 : k - 1],
+                               ids[k], tolerance);
     }
   }
+  geometry.volumes = volumes;
+  geometry.non_planar_face = non_planar_face;
+  geometry.reflex = reflex;
   return {};
 }
 
@@ -649,6 +659,21 @@ std::optional<PreparedMesh> check_operand(const Mesh& mesh, std::string_view nam
   found = convex_polyhedron(prepared.mesh, options.planarity_tolerance);
   if (found.verdict != Verdict::ok) raise(found);
   return prepared;
+}
+
+bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles, double planarity_tolerance) {
+  // convex_polyhedron() after closed_manifold(), on the caller's cycles: the same checks on
+  // the same values, without building the messages of a failure.
+  const MeshView m(mesh, true);  // the caller's precondition
+  Geometry geometry;
+  geometry.cycles.begin = cycles.begin;
+  geometry.cycles.vertex = cycles.vertex;
+  geometry.cycles.across = cycles.across;
+  if (nondegenerate(m, planarity_tolerance, geometry, true).verdict != Verdict::ok) return false;
+  if (outward(geometry.volumes).verdict != Verdict::ok) return false;
+  // A reflex flag means planar_and_convex() finds a reflex edge (the same test on the same
+  // face, edge and vertex): no need to look for it.
+  return geometry.non_planar_face < 0 && !geometry.reflex;
 }
 
 }  // namespace detail

@@ -2,6 +2,7 @@
 // for make_operand(), which reverses the facets of an inverted mesh itself.
 #pragma once
 
+#include <morph/error.h>
 #include <morph/validate.h>
 
 #include <optional>
@@ -9,11 +10,68 @@
 
 namespace morph::detail {
 
+/// A mesh's connectivity read as plain int arrays, for the passes that walk every
+/// halfedge: OpenMesh keeps each halfedge as four handles (face, target vertex, next,
+/// previous; the two of edge e at 2e and 2e + 1), each vertex and face as one halfedge
+/// handle, and indexing them here saves the handle arithmetic of each accessor call.
+/// Read only while the mesh is not changed.
+struct HalfedgeArrays {
+  explicit HalfedgeArrays(const Mesh& mesh) {
+    static_assert(sizeof(Mesh::Halfedge) == 4 * sizeof(int) &&
+                      sizeof(Mesh::Edge) == 2 * sizeof(Mesh::Halfedge) &&
+                      sizeof(Mesh::Vertex) == sizeof(int) && sizeof(Mesh::Face) == sizeof(int),
+                  "OpenMesh's array items are not plain handles");
+    if (mesh.n_halfedges() > 0) {
+      halfedge = reinterpret_cast<const int*>(&mesh.halfedge(Mesh::HalfedgeHandle(0)));
+      // The field order is fixed by OpenMesh's ArrayItems; checked once on a real halfedge.
+      const Mesh::HalfedgeHandle h(0);
+      if (face(0) != mesh.face_handle(h).idx() || to(0) != mesh.to_vertex_handle(h).idx() ||
+          next(0) != mesh.next_halfedge_handle(h).idx() ||
+          prev(0) != mesh.prev_halfedge_handle(h).idx())
+        throw error("internal error: unexpected layout of OpenMesh's halfedges");
+    }
+    if (mesh.n_vertices() > 0)
+      vertex_halfedge = reinterpret_cast<const int*>(&mesh.vertex(Mesh::VertexHandle(0)));
+    if (mesh.n_faces() > 0)
+      face_halfedge = reinterpret_cast<const int*>(&mesh.face(Mesh::FaceHandle(0)));
+  }
+  int face(int h) const { return halfedge[4 * h]; }
+  int to(int h) const { return halfedge[4 * h + 1]; }
+  int next(int h) const { return halfedge[4 * h + 2]; }
+  int prev(int h) const { return halfedge[4 * h + 3]; }
+  int from(int h) const { return to(h ^ 1); }
+  int halfedge_of_vertex(int v) const { return vertex_halfedge[v]; }
+  int halfedge_of_face(int f) const { return face_halfedge[f]; }
+
+  const int* halfedge = nullptr;
+  const int* vertex_halfedge = nullptr;
+  const int* face_halfedge = nullptr;
+};
+
 /// Checks `mesh` exactly as prepare_convex_polyhedron() does (same exceptions, same
 /// messages). Returns nothing when `mesh` is an operand as it is, and the flipped copy
 /// with its note when it was inverted and options.fix_inverted allowed the fix.
 /// Complexity: linear in the mesh (plus a copy only when it is inverted).
 std::optional<PreparedMesh> check_operand(const Mesh& mesh, std::string_view name,
                                           const ValidationOptions& options = {});
+
+/// A mesh's face cycles as check_operand reads them: corner k of face f is vertex
+/// vertex[begin[f] + k], counted from the target of the face's halfedge along its next
+/// links, and across[begin[f] + k] is the face across the edge that ends at that corner
+/// (begin has F + 1 entries).
+struct FaceCycleView {
+  const int* begin;
+  const int* vertex;
+  const int* across;
+};
+
+/// Whether check_operand(mesh) (with this tolerance) returns nothing: the mesh is an operand
+/// as it is. Only for a mesh without deleted elements that the caller has found to pass
+/// check_operand's topological checks (closed, every vertex one fan reaching each neighbour
+/// once, connected, Euler characteristic 2), with its face cycles: runs the geometric checks
+/// alone, on the same values with the same verdicts. False when check_operand would throw
+/// or flip the mesh (its caller then calls it, for the message). Linear in the mesh.
+bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles,
+                     double planarity_tolerance = kPlanarityTolerance);
 
 }  // namespace morph::detail
