@@ -89,6 +89,18 @@ Connectivity facet_cycles(const Soup& soup) {
     const int* begin = soup.begin.data();
     for (int f = first; f < last; ++f) {
       const int b = begin[f], e = begin[f + 1];
+      if (e - b == 3) {  // most facets: straight-line code (the loop's vector code is slower)
+        face[b] = face[b + 1] = face[b + 2] = f;
+        next[b] = b + 1, next[b + 1] = b + 2, next[b + 2] = b;
+        prev[b] = b + 2, prev[b + 1] = b, prev[b + 2] = b + 1;
+        continue;
+      }
+      if (e - b == 4) {
+        face[b] = face[b + 1] = face[b + 2] = face[b + 3] = f;
+        next[b] = b + 1, next[b + 1] = b + 2, next[b + 2] = b + 3, next[b + 3] = b;
+        prev[b] = b + 3, prev[b + 1] = b, prev[b + 2] = b + 1, prev[b + 3] = b + 2;
+        continue;
+      }
       if (b == e) continue;
       for (int c = b; c < e; ++c) {
         face[c] = f;
