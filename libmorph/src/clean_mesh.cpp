@@ -174,16 +174,17 @@ std::optional<Connectivity> connect(int num_points, const Soup& soup) {
   return k;
 }
 
-/// A facet's plane and size in doubles.
+/// A facet's plane and size in doubles. (No member initialisers: an array of them is left
+/// uninitialised until `geometry` fills it.)
 struct FacetGeometry {
-  V3<double> normal{0, 0, 0};  // unit (zero for a facet of zero area)
-  double offset = 0;           // <normal, x> = offset on the plane
-  double twice_area = 0;
-  double longest_edge = 0;
+  V3<double> normal;  // unit (zero for a facet of zero area)
+  double offset;      // <normal, x> = offset on the plane
+  double twice_area;
+  double longest_edge;
 };
 
 FacetGeometry geometry(const std::vector<V3<double>>& points, const Soup& soup, int f) {
-  FacetGeometry g;
+  FacetGeometry g{};  // zeros
   const int b = soup.begin[f], d = soup.degree(f);
   const V3<double>& origin = points[soup.vertex[b]];
   V3<double> sum{0, 0, 0}, centroid{0, 0, 0};
@@ -222,7 +223,7 @@ struct Groups {
 /// or the group joins it the other way round. Needles (facets thinner than `limit`) have
 /// no reliable plane of their own; they join a neighbour whose plane holds them.
 Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
-                      const Connectivity& k, const std::vector<FacetGeometry>& geo, double limit) {
+                      const Connectivity& k, const FacetGeometry* geo, double limit) {
   const int nf = soup.size();
   Groups out;
   std::vector<int>& next_member = out.next_member;
@@ -325,7 +326,8 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
                     double limit, bool strict, Soup& merged, MergedTwins& merged_twins,
                     bool& changed) {
   const int nf = soup.size();
-  std::vector<FacetGeometry> geo(nf);
+  const auto geo_array = std::make_unique_for_overwrite<FacetGeometry[]>(nf);
+  FacetGeometry* geo = geo_array.get();
   parallel_chunks(nf, kFacetGrain, [&](int first, int last) {
     for (int f = first; f < last; ++f) geo[f] = geometry(points, soup, f);
   });
