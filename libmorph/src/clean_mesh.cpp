@@ -314,10 +314,8 @@ bool convex_polygon(const std::vector<V3<double>>& points, const int* cycle, int
 /// found to be one, with no edge twice. Only the other corners and vertices are checked.
 struct MergedTwins {
   Ints twin;
-  std::vector<int> check_corner;  // merged corners, ascending
-  std::vector<int> check_vertex;  // points, each once
-  std::vector<int> count;         // merged corners leaving each point
-  Ints corner_at;                 // a merged corner leaving each point (where count > 0)
+  std::vector<int> check_corner;   // merged corners, ascending
+  std::vector<char> check_vertex;  // per point
 };
 
 /// Passes 2 and 3 on a closed manifold soup: the polygons of its coplanar groups go to
@@ -393,22 +391,13 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
   // or to a vertex that goes: what connect_with checks (see MergedTwins).
   // (A merged corner is lengthened from the walk of its polygon only, in order: the list
   // has each once.)
-  std::vector<int> long_chain, check_vertex;
-  std::vector<char> checked(np, 0);  // in check_vertex
-  const auto check = [&](int v) {
-    if (!checked[v]) {
-      checked[v] = 1;
-      check_vertex.push_back(v);
-    }
-  };
+  std::vector<int> long_chain;
+  std::vector<char> check_vertex(np, 0);
   const auto lengthen = [&](int m, int c) {
     chain_end[m] = c;
     if (long_chain.empty() || long_chain.back() != m) long_chain.push_back(m);
-    check(out.vertex[m]);
+    check_vertex[out.vertex[m]] = 1;
   };
-  // The fans that connect_with checks are found from these (no pass over the merged soup).
-  std::vector<int> count(np, 0);
-  Ints corner_at(np);
   // The polygons that are not a facet as it is (a merged group, or a facet that lost a
   // vertex), with their group's largest facet: the only ones whose corners need a test. A
   // facet left as it is has no test when nothing merges either (the soup is kept then).
@@ -418,11 +407,9 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
     const int first = size;
     int before_first = -1;  // the last corner walked before the first kept one
     const auto add = [&](int c) {
-      if (const int v = soup.vertex[c]; keep[v]) {
+      if (keep[soup.vertex[c]]) {
         chain_of[c] = size;
-        out.vertex[size] = v;
-        ++count[v];
-        corner_at[v] = size;
+        out.vertex[size] = soup.vertex[c];
         chain_end[size++] = c;
       } else if (size == first) {
         before_first = c;
@@ -462,7 +449,7 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
         add(c);
         // The next boundary corner: turn around the edge's end inside the group.
         int n = k.next[c];
-        if (group(k.twin[n]) == g) check(soup.vertex[n]);  // an edge inside g
+        if (group(k.twin[n]) == g) check_vertex[soup.vertex[n]] = 1;  // an edge inside g
         while (group(k.twin[n]) == g) {
           n = k.next[k.twin[n]];
           if (++steps > nc) return false;
@@ -498,8 +485,6 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
   for (int m = 0; m < size; ++m) merged_twins.twin[m] = chain_of[k.twin[chain_end[m]]];
   merged_twins.check_corner = std::move(long_chain);
   merged_twins.check_vertex = std::move(check_vertex);
-  merged_twins.count = std::move(count);
-  merged_twins.corner_at = std::move(corner_at);
   merged = std::move(out);
   return true;
 }
@@ -528,16 +513,18 @@ std::optional<Connectivity> connect_with(int num_points, const Soup& soup, Merge
     }
   });
   if (!reverse.load()) return std::nullopt;
-  std::vector<int> marks(num_points, -1);
+  std::vector<int> out_count(num_points, 0), marks(num_points, -1);
   // Plain pointers: the writes through them could alias the arrays' own pointers.
   const int *vertex = soup.vertex.data(), *next = k.next.data(), *prev = k.prev.data(),
-            *twins = k.twin.data(), *count = merged.count.data();
-  int* mark = marks.data();
-  for (const int v : merged.check_vertex) {
-    if (count[v] == 0) continue;  // not in the merged soup
+            *twins = k.twin.data();
+  int *count = out_count.data(), *mark = marks.data();
+  const char* check = merged.check_vertex.data();
+  for (int c = 0; c < nc; ++c) ++count[vertex[c]];
+  for (int s = 0; s < nc; ++s) {
+    const int v = vertex[s];
+    if (!check[v] || count[v] < 0) continue;  // its fan needs no check, or is checked
     // Turning from an outgoing edge to the next is a permutation of the corners leaving v:
-    // one fan when its orbit (from any of them) holds all of them.
-    const int s = merged.corner_at[v];
+    // one fan when its orbit holds all of them.
     int c = s, steps = 0;
     do {
       int& m = mark[vertex[next[c]]];
@@ -547,6 +534,7 @@ std::optional<Connectivity> connect_with(int num_points, const Soup& soup, Merge
       ++steps;
     } while (c != s && steps <= count[v]);
     if (steps != count[v] || c != s) return std::nullopt;
+    count[v] = -1;
   }
   return k;
 }
