@@ -208,4 +208,70 @@ TEST_CASE("clean_mesh merges large grids of nearly coplanar facets alike with 1 
   }
 }
 
+// A prism over an L-shaped hexagon (not convex: its top and bottom are not convex polygons),
+// as a soup: `split_side` splits its first side into two triangles, `split_top` splits its
+// top into two convex quads along the diagonal from (0,0) to the reflex corner (1,1).
+// Points 0-5 are the L at z = 0, 6-11 the same at z = 1.
+std::vector<int> l_prism(bool split_side, bool split_top, std::vector<V3<double>>& points,
+                         std::vector<int>& begin) {
+  const double l[6][2] = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};  // counter-clockwise
+  points.clear();
+  for (int z = 0; z < 2; ++z)
+    for (const auto& p : l) points.push_back({p[0], p[1], double(z)});
+  std::vector<int> corners;
+  begin.assign(1, 0);
+  auto add = [&](const std::vector<int>& f) {
+    corners.insert(corners.end(), f.begin(), f.end());
+    begin.push_back(static_cast<int>(corners.size()));
+  };
+  add({5, 4, 3, 2, 1, 0});  // bottom
+  if (split_top) {
+    add({6, 7, 8, 9});
+    add({6, 9, 10, 11});
+  } else {
+    add({6, 7, 8, 9, 10, 11});
+  }
+  for (int i = 0; i < 6; ++i) {
+    const int j = (i + 1) % 6;
+    if (i == 0 && split_side) {
+      add({i, j, 6 + j});
+      add({i, 6 + j, 6 + i});
+    } else {
+      add({i, j, 6 + j, 6 + i});
+    }
+  }
+  return corners;
+}
+
+// A facet left as it is (no merge, no vertex dropped) has no corner test, whether or not
+// other facets merge: the L-shaped top and bottom stay when a side merges as when nothing
+// does. A merged polygon that is not convex fails its test: the mesh is then the convex
+// hull of the points (the reflex edge's two points are inside it).
+TEST_CASE("clean_mesh tests the corners of merged polygons only") {
+  std::vector<V3<double>> points;
+  std::vector<int> begin, source;
+  for (bool split_side : {false, true}) {
+    CAPTURE(split_side);
+    const std::vector<int> corners = l_prism(split_side, false, points, begin);
+    const morph::Mesh mesh = clean_mesh(points, begin, corners, &source);
+    CHECK(mesh.n_vertices() == 12);
+    CHECK(mesh.n_faces() == 8);
+    CHECK(mesh.n_edges() == 18);
+    int hexagons = 0;
+    for (auto f : mesh.faces()) hexagons += mesh.valence(f) == 6;
+    CHECK(hexagons == 2);
+    CHECK(source.size() == 8);
+  }
+  for (bool split_side : {false, true}) {
+    CAPTURE(split_side);
+    const std::vector<int> corners = l_prism(split_side, true, points, begin);
+    const morph::Mesh mesh = clean_mesh(points, begin, corners, &source);
+    CHECK(mesh.n_vertices() == 10);  // the hull: (1, 1, z) are inside it
+    CHECK(mesh.n_faces() == 7);      // two pentagons and five quads
+    CHECK(mesh.n_edges() == 15);
+    for (auto v : mesh.vertices()) CHECK_FALSE((mesh.point(v)[0] == 1 && mesh.point(v)[1] == 1));
+    for (auto h : mesh.halfedges()) CHECK_FALSE(mesh.is_boundary(h));
+  }
+}
+
 }  // namespace

@@ -89,6 +89,18 @@ Connectivity facet_cycles(const Soup& soup) {
     const int* begin = soup.begin.data();
     for (int f = first; f < last; ++f) {
       const int b = begin[f], e = begin[f + 1];
+      if (e - b == 3) {  // most facets: straight-line code (the loop's vector code is slower)
+        face[b] = face[b + 1] = face[b + 2] = f;
+        next[b] = b + 1, next[b + 1] = b + 2, next[b + 2] = b;
+        prev[b] = b + 2, prev[b + 1] = b, prev[b + 2] = b + 1;
+        continue;
+      }
+      if (e - b == 4) {
+        face[b] = face[b + 1] = face[b + 2] = face[b + 3] = f;
+        next[b] = b + 1, next[b + 1] = b + 2, next[b + 2] = b + 3, next[b + 3] = b;
+        prev[b] = b + 3, prev[b + 1] = b, prev[b + 2] = b + 1, prev[b + 3] = b + 2;
+        continue;
+      }
       if (b == e) continue;
       for (int c = b; c < e; ++c) {
         face[c] = f;
@@ -162,16 +174,17 @@ std::optional<Connectivity> connect(int num_points, const Soup& soup) {
   return k;
 }
 
-/// A facet's plane and size in doubles.
+/// A facet's plane and size in doubles. (No member initialisers: an array of them is left
+/// uninitialised until `geometry` fills it.)
 struct FacetGeometry {
-  V3<double> normal{0, 0, 0};  // unit (zero for a facet of zero area)
-  double offset = 0;           // <normal, x> = offset on the plane
-  double twice_area = 0;
-  double longest_edge = 0;
+  V3<double> normal;  // unit (zero for a facet of zero area)
+  double offset;      // <normal, x> = offset on the plane
+  double twice_area;
+  double longest_edge;
 };
 
 FacetGeometry geometry(const std::vector<V3<double>>& points, const Soup& soup, int f) {
-  FacetGeometry g;
+  FacetGeometry g{};  // zeros
   const int b = soup.begin[f], d = soup.degree(f);
   const V3<double>& origin = points[soup.vertex[b]];
   V3<double> sum{0, 0, 0}, centroid{0, 0, 0};
@@ -210,7 +223,7 @@ struct Groups {
 /// or the group joins it the other way round. Needles (facets thinner than `limit`) have
 /// no reliable plane of their own; they join a neighbour whose plane holds them.
 Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
-                      const Connectivity& k, const std::vector<FacetGeometry>& geo, double limit) {
+                      const Connectivity& k, const FacetGeometry* geo, double limit) {
   const int nf = soup.size();
   Groups out;
   std::vector<int>& next_member = out.next_member;
@@ -301,7 +314,7 @@ bool convex_polygon(const std::vector<V3<double>>& points, const int* cycle, int
 /// found to be one, with no edge twice. Only the other corners and vertices are checked.
 struct MergedTwins {
   Ints twin;
-  std::vector<char> check_corner;  // per merged corner
+  std::vector<int> check_corner;   // merged corners, ascending
   std::vector<char> check_vertex;  // per point
 };
 
@@ -313,7 +326,8 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
                     double limit, bool strict, Soup& merged, MergedTwins& merged_twins,
                     bool& changed) {
   const int nf = soup.size();
-  std::vector<FacetGeometry> geo(nf);
+  const auto geo_array = std::make_unique_for_overwrite<FacetGeometry[]>(nf);
+  FacetGeometry* geo = geo_array.get();
   parallel_chunks(nf, kFacetGrain, [&](int first, int last) {
     for (int f = first; f < last; ++f) geo[f] = geometry(points, soup, f);
   });
@@ -375,28 +389,21 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
   Ints chain_end(nc);  // merged corner -> its chain's last boundary corner
   // Merged corners of more than one boundary corner, vertices with an edge inside a group
   // or to a vertex that goes: what connect_with checks (see MergedTwins).
-  std::vector<char> long_chain(nc, 0), check_vertex(np, 0);
+  // (A merged corner is lengthened from the walk of its polygon only, in order: the list
+  // has each once.)
+  std::vector<int> long_chain;
+  std::vector<char> check_vertex(np, 0);
   const auto lengthen = [&](int m, int c) {
     chain_end[m] = c;
-    long_chain[m] = 1;
+    if (long_chain.empty() || long_chain.back() != m) long_chain.push_back(m);
     check_vertex[out.vertex[m]] = 1;
   };
-  std::vector<int> largest(nf, -1);  // the group's largest facet gives its source
-  for (int f = 0; f < nf; ++f) {
-    int& l = largest[groups.of[f]];
-    if (l < 0 || geo[f].twice_area > geo[l].twice_area) l = f;
-  }
+  // The polygons that are not a facet as it is (a merged group, or a facet that lost a
+  // vertex), with their group's largest facet: the only ones whose corners need a test. A
+  // facet left as it is has no test when nothing merges either (the soup is kept then).
+  std::vector<std::pair<int, int>> to_test;
   for (int g = 0; g < nf; ++g) {
     if (groups.of[g] != g) continue;
-    // The group's first boundary corner and its number of boundary corners, from its members.
-    int start = nc, boundary = 0;
-    for (int f = g; f >= 0; f = groups.next_member[f])
-      for (int c = soup.begin[f]; c < soup.begin[f + 1]; ++c)
-        if (group(k.twin[c]) != g) {
-          start = std::min(start, c);
-          ++boundary;
-        }
-    if (boundary == 0) return false;  // a group without boundary: everything is flat
     const int first = size;
     int before_first = -1;  // the last corner walked before the first kept one
     const auto add = [&](int c) {
@@ -410,10 +417,30 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
         lengthen(size - 1, c);
       }
     };
-    if (groups.next_member[g] < 0 && boundary == soup.degree(g)) {
-      // A facet alone with all its edges on the boundary is its own boundary cycle.
+    if (groups.next_member[g] < 0) {
+      // A facet alone is its own boundary cycle: none of its edges has its twin in it (a
+      // soup's facets have three corners or more, none repeated, so the reverse of an edge
+      // is in another facet).
       for (int c = soup.begin[g]; c < soup.begin[g + 1]; ++c) add(c);
+      if (size - first != soup.degree(g)) to_test.emplace_back(polygons, g);
+      out.source[polygons] = soup.source[g];
     } else {
+      // The group's first boundary corner and its number of boundary corners, and its
+      // largest facet (the first of the largest in facet order; g is the first member),
+      // which gives its source, from its members.
+      int start = nc, boundary = 0, largest = g;
+      for (int f = g; f >= 0; f = groups.next_member[f]) {
+        const double area = geo[f].twice_area, most = geo[largest].twice_area;
+        if (area > most || (area == most && f < largest)) largest = f;
+        for (int c = soup.begin[f]; c < soup.begin[f + 1]; ++c)
+          if (group(k.twin[c]) != g) {
+            start = std::min(start, c);
+            ++boundary;
+          }
+      }
+      if (boundary == 0) return false;  // a group without boundary: everything is flat
+      to_test.emplace_back(polygons, largest);
+      out.source[polygons] = soup.source[largest];
       int c = start, steps = 0, walked = 0;
       do {
         // More corners than the group's boundary has: the walk cannot end well (and the
@@ -437,19 +464,18 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
     const int d = size - first;
     if (before_first >= 0 && d > 0) lengthen(size - 1, before_first);  // the chain wraps
     if (d < 3) return false;
-    out.source[polygons] = soup.source[largest[g]];
     out.begin[++polygons] = size;
   }
   out.begin.resize(polygons + 1);
   out.source.resize(polygons);
-  // Each polygon's corner test, against the plane of its group's largest facet (the group
-  // of the corners its chains cover): independent, so in parallel, after the walks.
+  // Each polygon's corner test, against the plane of its group's largest facet:
+  // independent, so in parallel, after the walks.
   std::atomic<bool> convex{true};
-  parallel_chunks(out.size(), kFacetGrain, [&](int first, int last) {
-    for (int m = first; m < last && convex.load(std::memory_order_relaxed); ++m) {
-      const int b = out.begin[m];
-      const V3<double>& normal = geo[largest[group(chain_end[b])]].normal;
-      if (!convex_polygon(points, out.vertex.data() + b, out.degree(m), normal, limit))
+  parallel_chunks(static_cast<int>(to_test.size()), kFacetGrain, [&](int first, int last) {
+    for (int i = first; i < last && convex.load(std::memory_order_relaxed); ++i) {
+      const auto [m, largest] = to_test[i];
+      if (!convex_polygon(points, out.vertex.data() + out.begin[m], out.degree(m),
+                          geo[largest].normal, limit))
         convex.store(false, std::memory_order_relaxed);
     }
   });
@@ -457,7 +483,6 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
   out.vertex.resize(size);
   merged_twins.twin = Ints(size);
   for (int m = 0; m < size; ++m) merged_twins.twin[m] = chain_of[k.twin[chain_end[m]]];
-  long_chain.resize(size);
   merged_twins.check_corner = std::move(long_chain);
   merged_twins.check_vertex = std::move(check_vertex);
   merged = std::move(out);
@@ -475,12 +500,11 @@ std::optional<Connectivity> connect_with(int num_points, const Soup& soup, Merge
   Connectivity k = facet_cycles(soup);
   k.twin = std::move(merged.twin);
   std::atomic<bool> reverse{true};
-  parallel_chunks(nc, kCornerGrain, [&](int first, int last) {
+  const std::vector<int>& check_corner = merged.check_corner;
+  parallel_chunks(static_cast<int>(check_corner.size()), kCornerGrain, [&](int first, int last) {
     const int *vertex = soup.vertex.data(), *next = k.next.data(), *twin = k.twin.data();
-    const char* check = merged.check_corner.data();
-    for (int c = first; c < last; ++c) {
-      if (!check[c]) continue;
-      const int t = twin[c];
+    for (int i = first; i < last; ++i) {
+      const int c = check_corner[i], t = twin[c];
       if (t < 0 || t >= nc || t == c || twin[t] != c || vertex[t] != vertex[next[c]] ||
           vertex[next[t]] != vertex[c]) {
         reverse.store(false, std::memory_order_relaxed);
