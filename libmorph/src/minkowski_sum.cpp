@@ -249,6 +249,15 @@ void edge_facets(const Polytope& A, int a, const ArcPlane& plane_a, const Polyto
   for (const auto& [e, side_of_b] : crossings) emit(e, side_of_b);
 }
 
+/// Whether facets f and g of P share an edge: a scan of f's edges.
+bool facets_adjacent(const Polytope& P, int f, int g) {
+  for (int k = P.face_begin[f]; k < P.face_begin[f + 1]; ++k) {
+    const auto& e = P.edges[P.corner_edge[k]];
+    if (e.left == g || e.right == g) return true;
+  }
+  return false;
+}
+
 /// Where to start locating each facet f of X in Y's Gauss map, from Y's facets located in
 /// X's (loc_y): N_f is the common corner of the regions of f's corners in X's map, so the
 /// facets of Y whose normals those regions contain are the ones near it; the walk starts
@@ -343,6 +352,12 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
         const auto& r = loc_a[A.edges[a].right];
         if (l.kind == Location::Kind::vertex && r.kind == Location::Kind::vertex &&
             l.index == r.index)
+          continue;
+        // a's arc is an arc of B's map (its facets' normals are those of two adjacent facets
+        // of B: parallel edges, as in A (+) A): the other arcs of B meet it only at its ends,
+        // so it crosses none.
+        if (l.kind == Location::Kind::face && r.kind == Location::Kind::face &&
+            facets_adjacent(B, l.index, r.index))
           continue;
         edge_facets(A, a, planes_a[a], B, l, r, w, out);
       }
