@@ -70,7 +70,9 @@ int region_test(const Polytope& P, const ArcPlane* slots, int v, const NormalRef
   for (int i = 0; i < n; ++i) {
     int s = orient_arc_filter(plane(i), p);
     if (s == kUndecided)
-      s = orient_undecided(NormalRef{&P, fan[i]}, NormalRef{&P, fan[i + 1 == n ? 0 : i + 1]}, p);
+      // p at a facet normal of this map (A (+) A) is the usual reason for an undecided slot.
+      s = orient_undecided(NormalRef{&P, fan[i]}, NormalRef{&P, fan[i + 1 == n ? 0 : i + 1]}, p,
+                           true);
     if (s < 0) return i;
     if (s == 0) {
       if (nzeros == 2) throw error("internal error: a direction lies on three arcs of one region");
@@ -93,25 +95,29 @@ Location classify(const Polytope& P, int v, const int zeros[2], int nzeros) {
 }  // namespace
 
 bool translated_cycles(const Polytope& P, int f, const Polytope& Q, int g) {
-  if (!P.given_normals.empty() || !Q.given_normals.empty()) return false;
   const int d = P.degree(f);
-  if (Q.degree(g) != d) return false;
+  if (Q.degree(g) != d || !P.given_normals.empty() || !Q.given_normals.empty()) return false;
+  const V3<double>* const pp = P.points.data();
+  const V3<double>* const qp = Q.points.data();
   const int* const p = &P.corner_vertex[P.face_begin[f]];
   const int* const q = &Q.corner_vertex[Q.face_begin[g]];
-  auto at = [&](int r, int k) -> const V3<double>& {
-    return Q.points[q[r + k < d ? r + k : r + k - d]];
-  };
+  auto at = [&](int r, int k) -> const V3<double>& { return qp[q[r + k < d ? r + k : r + k - d]]; };
   // Where q's cycle may start (r): a translate's first edge is the same vector as p's,
-  // rounded alike (in whatever mode), and usually no start passes (only a shortcut).
-  // Then the same points (compared as numbers), or translates: q_k - p_k the same vector
-  // for all k. In round-to-nearest, two_sum gives each difference exactly as (its
-  // rounding, the remainder), a function of the real difference: equal pairs are equal
-  // differences (finite: no overflow).
-  const V3<double>& p0 = P.points[p[0]];
-  const V3<double> edge = P.points[p[1]] - p0;
+  // rounded alike (in whatever mode), and usually no start passes (only a shortcut: its
+  // x first, the usual way out). Then the same points (compared as numbers), or
+  // translates: q_k - p_k the same vector for all k. In round-to-nearest, two_sum gives
+  // each difference exactly as (its rounding, the remainder), a function of the real
+  // difference: equal pairs are equal differences (finite: no overflow).
+  const V3<double>& p0 = pp[p[0]];
+  const V3<double>& p1 = pp[p[1]];
+  const double edge_x = p1.x - p0.x;
+  auto same_edge = [&](int r) {
+    const V3<double>&a = at(r, 0), &b = at(r, 1);
+    return b.x - a.x == edge_x && b.y - a.y == p1.y - p0.y && b.z - a.z == p1.z - p0.z;
+  };
   auto same_points = [&](int r) {
     for (int k = 0; k < d; ++k) {
-      const V3<double>& a = P.points[p[k]];
+      const V3<double>& a = pp[p[k]];
       const V3<double>& b = at(r, k);
       if (!(a.x == b.x && a.y == b.y && a.z == b.z)) return false;
     }
@@ -128,23 +134,24 @@ bool translated_cycles(const Polytope& P, int f, const Polytope& Q, int g) {
     DD t[3], s[3];
     if (!difference(at(r, 0), p0, t)) return false;
     for (int k = 1; k < d; ++k) {
-      if (!difference(at(r, k), P.points[p[k]], s)) return false;
+      if (!difference(at(r, k), pp[p[k]], s)) return false;
       if (!(s[0].hi == t[0].hi && s[0].lo == t[0].lo && s[1].hi == t[1].hi && s[1].lo == t[1].lo &&
             s[2].hi == t[2].hi && s[2].lo == t[2].lo))
         return false;
     }
     return true;
   };
-  for (int r = 0; r < d; ++r) {
-    const V3<double> e = at(r, 1) - at(r, 0);
-    if (e.x == edge.x && e.y == edge.y && e.z == edge.z && (same_points(r) || translates(r)))
-      return true;
-  }
+  for (int r = 0; r < d; ++r)
+    if (same_edge(r) && (same_points(r) || translates(r))) return true;
   return false;
 }
 
-int orient_undecided(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
-  if ((same_unit(a, c) && same_normal(a, c)) || (same_unit(b, c) && same_normal(b, c))) return 0;
+int orient_undecided(const NormalRef& a, const NormalRef& b, const NormalRef& c,
+                     bool likely_equal) {
+  if (likely_equal
+          ? same_normal(a, c) || same_normal(b, c)
+          : (same_unit(a, c) && same_normal(a, c)) || (same_unit(b, c) && same_normal(b, c)))
+    return 0;
   const int s = orient_normals_precise(a, b, c);
   if (s != kUndecided) return s;
   if (same_normal(a, c) || same_normal(b, c) || same_normal(a, b)) return 0;

@@ -50,15 +50,17 @@ inline bool same_unit(const NormalRef& x, const NormalRef& y) {
 
 /// orient_normals_undecided (for what the double filter leaves undecided), with
 /// same_normal's shortcut: two equal directions make the determinant zero. Tried before
-/// the double-double stage when the unit normals hint at it, else only before the exact
-/// stage, so that nearly parallel normals (fine spheres) pay nothing for it.
-int orient_undecided(const NormalRef& a, const NormalRef& b, const NormalRef& c);
+/// the double-double stage when the unit normals hint at it (equal doubles, or, when the
+/// caller expects coincident normals (`likely_equal`), any within reach), else only
+/// before the exact stage, so that nearly parallel normals (fine spheres) pay little for it.
+int orient_undecided(const NormalRef& a, const NormalRef& b, const NormalRef& c,
+                     bool likely_equal = false);
 
-/// Sign of det(a, b, c) for three normals: orient_normals' double filter, then
-/// orient_undecided.
+/// Sign of det(a, b, c) for three normals (the overlay's, at a point where the maps'
+/// normals often coincide): orient_normals' double filter, then orient_undecided.
 inline int orient(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
   const int s = orient_normals_filter(a, b, c);
-  return s != kUndecided ? s : orient_undecided(a, b, c);
+  return s != kUndecided ? s : orient_undecided(a, b, c, true);
 }
 
 /// The plane of an arc of a Gauss map: N_left x N_right of its edge, from the unit normals
