@@ -124,6 +124,12 @@ bool translated_cycles(const Polytope& P, int f, const Polytope& Q, int g) {
     return true;
   };
   auto translates = [&](int r) {
+    // Equal differences round alike (in whatever mode): a cheap way out first.
+    const V3<double> t0 = at(r, 0) - p0;
+    for (int k = 1; k < d; ++k) {
+      const V3<double> t = at(r, k) - pp[p[k]];
+      if (!(t.x == t0.x && t.y == t0.y && t.z == t0.z)) return false;
+    }
     CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
     auto difference = [](const V3<double>& b, const V3<double>& a, DD t[3]) {
       t[0] = two_sum(b.x, -a.x);
