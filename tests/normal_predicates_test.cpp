@@ -10,6 +10,8 @@
 #include <cmath>
 #include <numeric>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "../libmorph/src/gauss_map.h"
@@ -234,5 +236,95 @@ TEST_CASE("normal predicates: a region's slot planes agree with exact evaluation
     CHECK(flipped > 0);
     CHECK(decided > 0);
     MESSAGE(tested << " slot orientations, " << decided << " decided by the filter");
+  }
+}
+
+// same_normal (gauss_map.h) spares the later stages the predicates on exactly coincident
+// normals (A (+) A, A (+) -A, A (+) an exact translate): it must claim equal directions only
+// where they are exactly equal, and the kernel's predicates with that shortcut must still
+// agree with exact evaluation on triples holding such pairs, also scaled by 2^+-200 and
+// moved far from the origin (where it must claim nothing that is not exact).
+TEST_CASE("normal predicates: same_normal and the kernel's orientations on coincident normals") {
+  using morph::Point;
+  namespace test = morph::test;
+  const Mesh ico320 = sample("icosphere_320.off");
+  const Mesh integer = test::random_integer_polytope(30, 17, 4);
+  const std::vector<double> up = {0x1p200, 0, 0, 0, 0x1p200, 0, 0, 0, 0x1p200};
+  const std::vector<double> down = {0x1p-200, 0, 0, 0, 0x1p-200, 0, 0, 0, 0x1p-200};
+  struct Pair {
+    std::string what;
+    Mesh a, b;
+    bool coincident;  // same_normal must find every exactly equal direction
+  };
+  const std::vector<Pair> pairs = {
+      {"icosphere A + A", ico320, ico320, true},
+      {"icosphere A + -A (centrally symmetric)", ico320, test::reflected(ico320), true},
+      {"integer A + exact translate", integer, test::translated(integer, Point(3, -1, 7)), true},
+      {"integer A + -A", integer, test::reflected(integer), false},
+      {"icosphere A + A, both scaled by 2^200", test::transformed(ico320, up),
+       test::transformed(ico320, up), true},
+      {"icosphere A + A, both scaled by 2^-200", test::transformed(ico320, down),
+       test::transformed(ico320, down), true},
+      {"icosphere scaled by 2^-200 and by 2^200", test::transformed(ico320, down),
+       test::transformed(ico320, up), false},
+      {"icosphere and a rounded far translate", ico320, shifted(ico320, 1024), false},
+      {"icosphere and a copy turned by 1e-12", ico320,
+       test::transformed(ico320, small_rotation(1e-12)), false},
+  };
+  for (const auto& pair : pairs) {
+    CAPTURE(pair.what);
+    const Polytope A = morph::detail::make_operand(pair.a, "A");
+    const Polytope B = morph::detail::make_operand(pair.b, "B");
+    const auto planes = morph::detail::arc_planes(B);
+    int equal = 0, shown = 0, tested = 0, zero = 0;
+    std::vector<int> order(B.num_faces());
+    for (int f = 0; f < A.num_faces(); ++f) {
+      const NormalRef a{&A, f};
+      closest_three(B, a.unit(), order);
+      for (int k = 0; k < 3; ++k) {
+        const NormalRef b{&B, order[k]};
+        const auto c = morph::detail::cross(a.exact(), b.exact());
+        const bool same = CGAL::sign(c.x) == CGAL::ZERO && CGAL::sign(c.y) == CGAL::ZERO &&
+                          CGAL::sign(c.z) == CGAL::ZERO &&
+                          CGAL::sign(morph::detail::dot(a.exact(), b.exact())) > 0;
+        const bool claimed = morph::detail::same_normal(a, b);
+        CHECK(morph::detail::same_normal(b, a) == claimed);
+        if (claimed) CHECK(same);
+        if (pair.coincident && same) CHECK(claimed);
+        equal += same;
+        shown += claimed;
+      }
+      // Triples of a, its nearest facet of B, and their neighbours, in all the forms the
+      // kernel evaluates: orient on three normals and against B's arc planes.
+      const NormalRef b{&B, order[0]};
+      std::vector<NormalRef> around;
+      for (const auto& [P, g] : {std::pair{&A, f}, std::pair{&B, order[0]}})
+        for (int i = P->face_begin[g]; i < P->face_begin[g + 1]; ++i) {
+          const auto& e = P->edges[P->corner_edge[i]];
+          around.push_back({P, e.left == g ? e.right : e.left});
+        }
+      for (const NormalRef& x : around) {
+        for (const auto& [p, q, r] :
+             {std::tuple{a, b, x}, std::tuple{b, x, a}, std::tuple{x, a, b}}) {
+          const int exact = CGAL::sign(morph::detail::det(p.exact(), q.exact(), r.exact()));
+          CHECK(morph::detail::orient(p, q, r) == exact);
+          zero += exact == 0;
+          ++tested;
+        }
+      }
+      for (int i = B.face_begin[b.face]; i < B.face_begin[b.face + 1]; ++i) {
+        const int e = B.corner_edge[i];
+        const NormalRef l{&B, B.edges[e].left}, r{&B, B.edges[e].right};
+        for (const NormalRef& x : {a, around[0]}) {
+          const int exact = CGAL::sign(morph::detail::det(l.exact(), r.exact(), x.exact()));
+          CHECK(morph::detail::orient_arc(B, e, planes[e], x) == exact);
+          ++tested;
+        }
+      }
+    }
+    MESSAGE(pair.what << ": " << equal << " exactly equal directions among the nearest, " << shown
+                      << " shown by same_normal; " << tested << " orientations, " << zero
+                      << " exactly zero");
+    if (pair.coincident) CHECK(shown > 0);
   }
 }

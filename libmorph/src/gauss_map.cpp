@@ -2,6 +2,7 @@
 
 #include <morph/error.h>
 
+#include <cmath>
 #include <string>
 
 #include "parallel.h"
@@ -12,7 +13,22 @@ namespace {
 
 /// X lies on the closed arc (p, q), given that it lies on the great circle through them.
 bool between(const NormalRef& p, const NormalRef& x, const NormalRef& q) {
-  return cross_dot_normals(p, x, p, q) >= 0 && cross_dot_normals(x, q, p, q) >= 0;
+  // At an end: (p x p) . (p x q) = 0 and (p x q) . (p x q) > 0 (p, q the distinct ends
+  // of an arc), and likewise at q. Shortcuts as in orient_undecided: first when the unit
+  // normals hint at it, else between the double-double and the exact stages.
+  if ((same_unit(x, p) && same_normal(x, p)) || (same_unit(x, q) && same_normal(x, q))) return true;
+  auto sign = [](const NormalRef& a, const NormalRef& b, const NormalRef& c, const NormalRef& d) {
+    const int s = cross_dot_normals_filter(a, b, c, d);
+    return s != kUndecided ? s : cross_dot_normals_precise(a, b, c, d);
+  };
+  const int s1 = sign(p, x, p, q);
+  if (s1 < 0) return false;
+  const int s2 = sign(x, q, p, q);
+  if (s2 < 0) return false;
+  if (s1 != kUndecided && s2 != kUndecided) return true;
+  if (same_normal(x, p) || same_normal(x, q)) return true;
+  return (s1 != kUndecided || cross_dot_normals_exact(p, x, p, q) >= 0) &&
+         (s2 != kUndecided || cross_dot_normals_exact(x, q, p, q) >= 0);
 }
 
 /// Signs of det(N_fan[i], N_fan[i+1], p) for the slots of v's region (`slots`: P's
@@ -54,8 +70,9 @@ int region_test(const Polytope& P, const ArcPlane* slots, int v, const NormalRef
   for (int i = 0; i < n; ++i) {
     int s = orient_arc_filter(plane(i), p);
     if (s == kUndecided)
-      s = orient_normals_undecided(NormalRef{&P, fan[i]},
-                                   NormalRef{&P, fan[i + 1 == n ? 0 : i + 1]}, p);
+      // p at a facet normal of this map (A (+) A) is the usual reason for an undecided slot.
+      s = orient_undecided(NormalRef{&P, fan[i]}, NormalRef{&P, fan[i + 1 == n ? 0 : i + 1]}, p,
+                           true);
     if (s < 0) return i;
     if (s == 0) {
       if (nzeros == 2) throw error("internal error: a direction lies on three arcs of one region");
@@ -76,6 +93,76 @@ Location classify(const Polytope& P, int v, const int zeros[2], int nzeros) {
 }
 
 }  // namespace
+
+bool translated_cycles(const Polytope& P, int f, const Polytope& Q, int g) {
+  const int d = P.degree(f);
+  if (Q.degree(g) != d || !P.given_normals.empty() || !Q.given_normals.empty()) return false;
+  const V3<double>* const pp = P.points.data();
+  const V3<double>* const qp = Q.points.data();
+  const int* const p = &P.corner_vertex[P.face_begin[f]];
+  const int* const q = &Q.corner_vertex[Q.face_begin[g]];
+  auto at = [&](int r, int k) -> const V3<double>& { return qp[q[r + k < d ? r + k : r + k - d]]; };
+  // Where q's cycle may start (r): a translate's first edge is the same vector as p's,
+  // rounded alike (in whatever mode), and usually no start passes (only a shortcut: its
+  // x first, the usual way out). Then the same points (compared as numbers), or
+  // translates: q_k - p_k the same vector for all k. In round-to-nearest, two_sum gives
+  // each difference exactly as (its rounding, the remainder), a function of the real
+  // difference: equal pairs are equal differences (finite: no overflow).
+  const V3<double>& p0 = pp[p[0]];
+  const V3<double>& p1 = pp[p[1]];
+  const double edge_x = p1.x - p0.x;
+  auto same_edge = [&](int r) {
+    const V3<double>&a = at(r, 0), &b = at(r, 1);
+    return b.x - a.x == edge_x && b.y - a.y == p1.y - p0.y && b.z - a.z == p1.z - p0.z;
+  };
+  auto same_points = [&](int r) {
+    for (int k = 0; k < d; ++k) {
+      const V3<double>& a = pp[p[k]];
+      const V3<double>& b = at(r, k);
+      if (!(a.x == b.x && a.y == b.y && a.z == b.z)) return false;
+    }
+    return true;
+  };
+  auto translates = [&](int r) {
+    // Equal differences round alike (in whatever mode): a cheap way out first.
+    const V3<double> t0 = at(r, 0) - p0;
+    for (int k = 1; k < d; ++k) {
+      const V3<double> t = at(r, k) - pp[p[k]];
+      if (!(t.x == t0.x && t.y == t0.y && t.z == t0.z)) return false;
+    }
+    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    auto difference = [](const V3<double>& b, const V3<double>& a, DD t[3]) {
+      t[0] = two_sum(b.x, -a.x);
+      t[1] = two_sum(b.y, -a.y);
+      t[2] = two_sum(b.z, -a.z);
+      return std::isfinite(t[0].hi) && std::isfinite(t[1].hi) && std::isfinite(t[2].hi);
+    };
+    DD t[3], s[3];
+    if (!difference(at(r, 0), p0, t)) return false;
+    for (int k = 1; k < d; ++k) {
+      if (!difference(at(r, k), pp[p[k]], s)) return false;
+      if (!(s[0].hi == t[0].hi && s[0].lo == t[0].lo && s[1].hi == t[1].hi && s[1].lo == t[1].lo &&
+            s[2].hi == t[2].hi && s[2].lo == t[2].lo))
+        return false;
+    }
+    return true;
+  };
+  for (int r = 0; r < d; ++r)
+    if (same_edge(r) && (same_points(r) || translates(r))) return true;
+  return false;
+}
+
+int orient_undecided(const NormalRef& a, const NormalRef& b, const NormalRef& c,
+                     bool likely_equal) {
+  if (likely_equal
+          ? same_normal(a, c) || same_normal(b, c)
+          : (same_unit(a, c) && same_normal(a, c)) || (same_unit(b, c) && same_normal(b, c)))
+    return 0;
+  const int s = orient_normals_precise(a, b, c);
+  if (s != kUndecided) return s;
+  if (same_normal(a, c) || same_normal(b, c) || same_normal(a, b)) return 0;
+  return orient_normals_exact(a, b, c);
+}
 
 std::vector<ArcPlane> arc_planes(const Polytope& P) {
   std::vector<ArcPlane> planes(P.num_edges());
@@ -231,6 +318,8 @@ void overlay_regions(const NormalRef& p, const std::vector<Arc>& x_arcs,
     const int s = orient(p, r, q);
     if (s > 0) return 1;
     if (s < 0) return 3;
+    // q in r's direction: (p x r) . (p x q) > 0, r being neither p nor -p.
+    if (same_normal(q, r)) return 0;
     return cross_dot_normals(p, r, p, q) > 0 ? 0 : 2;
   };
   auto compare = [&](const NormalRef& q1, int h1, const NormalRef& q2, int h2) {

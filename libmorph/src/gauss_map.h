@@ -3,6 +3,8 @@
 // point. These are the only geometric decisions of the FIMS kernel.
 #pragma once
 
+#include <cmath>
+
 #include "polytope.h"
 
 namespace morph::detail {
@@ -14,9 +16,51 @@ struct Location {
   int index = -1;
 };
 
-/// Sign of det(a, b, c) for three normals.
+/// Whether facets f of P and g of Q (polytopes whose exact normals are Newell's of their
+/// double points) have vertex cycles that are exact translates of each other, up to where
+/// the cycles start: then their exact normals are equal (Newell's normal is invariant under
+/// both). See same_normal.
+bool translated_cycles(const Polytope& P, int f, const Polytope& Q, int g);
+
+/// Whether the exact normals of x and y are known to have the same direction, by a cheap
+/// exact test: the same facet, or translated_cycles. False when that does not show it, even
+/// if the directions are equal: callers then decide by the general predicates. Operands
+/// with common facet directions (A (+) A, A (+) -A of a centrally symmetric A, A (+) an exact
+/// translate) make every predicate on such normals exactly zero, and this spares the
+/// double-double and exact stages their work on them. Inline, the usual answer (far apart
+/// unit normals, or two facets of one polytope, whose directions differ: canonical form)
+/// costs a few comparisons.
+inline bool same_normal(const NormalRef& x, const NormalRef& y) {
+  if (x.polytope == y.polytope) return x.face == y.face;
+  // Equal directions have unit normals within the sum of their bounds (doubled against
+  // the rounding of the differences): a cheap way out for the others. It only saves work.
+  const UnitNormal &u = x.unit(), &v = y.unit();
+  const double reach = 2 * (u.error + v.error);
+  return std::abs(u.x - v.x) <= reach && std::abs(u.y - v.y) <= reach &&
+         std::abs(u.z - v.z) <= reach &&
+         translated_cycles(*x.polytope, x.face, *y.polytope, y.face);
+}
+
+/// Unit normals with the same doubles: what the unit normals of translated cycles starting
+/// at the same corner (A (+) A) have, so a hint to try same_normal before anything else.
+inline bool same_unit(const NormalRef& x, const NormalRef& y) {
+  const UnitNormal &u = x.unit(), &v = y.unit();
+  return u.x == v.x && u.y == v.y && u.z == v.z;
+}
+
+/// orient_normals_undecided (for what the double filter leaves undecided), with
+/// same_normal's shortcut: two equal directions make the determinant zero. Tried before
+/// the double-double stage when the unit normals hint at it (equal doubles, or, when the
+/// caller expects coincident normals (`likely_equal`), any within reach), else only
+/// before the exact stage, so that nearly parallel normals (fine spheres) pay little for it.
+int orient_undecided(const NormalRef& a, const NormalRef& b, const NormalRef& c,
+                     bool likely_equal = false);
+
+/// Sign of det(a, b, c) for three normals (the overlay's, at a point where the maps'
+/// normals often coincide): orient_normals' double filter, then orient_undecided.
 inline int orient(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
-  return orient_normals(a, b, c);
+  const int s = orient_normals_filter(a, b, c);
+  return s != kUndecided ? s : orient_undecided(a, b, c, true);
 }
 
 /// The plane of an arc of a Gauss map: N_left x N_right of its edge, from the unit normals
@@ -46,8 +90,7 @@ std::vector<ArcPlane> arc_planes(const Polytope& P);
 std::vector<ArcPlane> slot_planes(const Polytope& P);
 
 /// Sign of det(N_left, N_right, x) for edge e of P, whose arc's plane is `plane`.
-/// Its double stage alone: the sign, or kUndecided.
-inline constexpr int kUndecided = 2;
+/// Its double stage alone: the sign, or kUndecided (polytope.h).
 /// The double stage's value of det(N_left, N_right, u) and the bound on its error.
 struct ArcFilter {
   double value, bound;
@@ -65,8 +108,7 @@ inline int orient_arc_filter(const ArcPlane& plane, const NormalRef& x) {
 inline int orient_arc(const Polytope& P, int e, const ArcPlane& plane, const NormalRef& x) {
   const int s = orient_arc_filter(plane, x);
   if (s != kUndecided) return s;
-  return orient_normals_undecided(NormalRef{&P, P.edges[e].left}, NormalRef{&P, P.edges[e].right},
-                                  x);
+  return orient_undecided(NormalRef{&P, P.edges[e].left}, NormalRef{&P, P.edges[e].right}, x);
 }
 
 /// Locates the direction `p` in P's Gauss map (`slots`: its slot_planes, or null to form each

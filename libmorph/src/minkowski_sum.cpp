@@ -105,11 +105,16 @@ struct WalkScratch {
   // orient(n1, n2, N_g), or kUndecided, when face_stamp[g] is current.
   std::vector<signed char> face_side;
   std::vector<int> queue;
+  // The regions next to the end region of the short arcs' shortcut (near_stamp[v] current),
+  // with the edge across (near_edge[v]).
+  std::vector<int> near_stamp, near_edge;
   explicit WalkScratch(const Polytope& B)
       : region_stamp(B.num_vertices(), 0),
         edge_stamp(B.num_edges(), 0),
         face_stamp(B.num_faces(), 0),
-        face_side(B.num_faces(), 0) {}
+        face_side(B.num_faces(), 0),
+        near_stamp(B.num_vertices(), 0),
+        near_edge(B.num_vertices(), 0) {}
 };
 
 /// Appends the edge facets of edge a of A: for each edge of B whose arc the arc of a
@@ -158,17 +163,23 @@ void edge_facets(const Polytope& A, int a, const ArcPlane& plane_a, const Polyto
       return true;
     };
     const int l = start.index, r = end.index;
+    // r's neighbours, marked once: then each region next to l is looked up, not scanned.
+    for (int s = B.fan_begin[r]; s < B.fan_begin[r + 1]; ++s) {
+      w.near_stamp[B.fan_vertex[s]] = a + 1;
+      w.near_edge[B.fan_vertex[s]] = B.fan_edge[s];
+    }
     int side1, side2;
-    if (const int e = B.edge_between(l, r); e >= 0) {
+    if (w.near_stamp[l] == a + 1) {  // l next to r
+      const int e = w.near_edge[l];
       if (crosses(e, side1)) {
         emit(e, side1);
         return;
       }
     } else {
       for (int s = B.fan_begin[l]; s < B.fan_begin[l + 1]; ++s) {
-        const int e2 = B.edge_between(B.fan_vertex[s], r);
-        if (e2 < 0) continue;
-        const int e1 = B.fan_edge[s];
+        const int v = B.fan_vertex[s];
+        if (w.near_stamp[v] != a + 1) continue;
+        const int e1 = B.fan_edge[s], e2 = w.near_edge[v];
         if (crosses(e1, side1) && crosses(e2, side2)) {  // in B's edge order
           emit(std::min(e1, e2), e1 < e2 ? side1 : side2);
           emit(std::max(e1, e2), e1 < e2 ? side2 : side1);
@@ -247,6 +258,15 @@ void edge_facets(const Polytope& A, int a, const ArcPlane& plane_a, const Polyto
   }
   std::sort(crossings.begin(), crossings.end());
   for (const auto& [e, side_of_b] : crossings) emit(e, side_of_b);
+}
+
+/// Whether facets f and g of P share an edge: a scan of f's edges.
+bool facets_adjacent(const Polytope& P, int f, int g) {
+  for (int k = P.face_begin[f]; k < P.face_begin[f + 1]; ++k) {
+    const auto& e = P.edges[P.corner_edge[k]];
+    if (e.left == g || e.right == g) return true;
+  }
+  return false;
 }
 
 /// Where to start locating each facet f of X in Y's Gauss map, from Y's facets located in
@@ -343,6 +363,12 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
         const auto& r = loc_a[A.edges[a].right];
         if (l.kind == Location::Kind::vertex && r.kind == Location::Kind::vertex &&
             l.index == r.index)
+          continue;
+        // a's arc is an arc of B's map (its facets' normals are those of two adjacent facets
+        // of B: parallel edges, as in A (+) A): the other arcs of B meet it only at its ends,
+        // so it crosses none.
+        if (l.kind == Location::Kind::face && r.kind == Location::Kind::face &&
+            facets_adjacent(B, l.index, r.index))
           continue;
         edge_facets(A, a, planes_a[a], B, l, r, w, out);
       }

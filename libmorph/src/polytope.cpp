@@ -264,6 +264,15 @@ void Polytope::compute_normals() {
 }
 
 int orient_normals_undecided(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
+  const int s = orient_normals_precise(a, b, c);
+  return s != kUndecided ? s : orient_normals_exact(a, b, c);
+}
+
+int orient_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
+  return CGAL::sign(det(a.exact(), b.exact(), c.exact()));
+}
+
+int orient_normals_precise(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
   {
     // Double-double needs round-to-nearest, whatever the caller set.
     CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
@@ -296,11 +305,22 @@ int orient_normals_undecided(const NormalRef& a, const NormalRef& b, const Norma
       if (value.hi < -bound) return -1;
     }
   }
-  return CGAL::sign(det(a.exact(), b.exact(), c.exact()));
+  return kUndecided;
 }
 
 int cross_dot_normals_undecided(const NormalRef& a, const NormalRef& b, const NormalRef& c,
                                 const NormalRef& d) {
+  const int s = cross_dot_normals_precise(a, b, c, d);
+  return s != kUndecided ? s : cross_dot_normals_exact(a, b, c, d);
+}
+
+int cross_dot_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef& c,
+                            const NormalRef& d) {
+  return CGAL::sign(cross_dot(a.exact(), b.exact(), c.exact(), d.exact()));
+}
+
+int cross_dot_normals_precise(const NormalRef& a, const NormalRef& b, const NormalRef& c,
+                              const NormalRef& d) {
   {
     // As orient_normals_undecided: double-double on precise normals (nearly parallel
     // normals give values far below what doubles resolve), in round-to-nearest.
@@ -339,7 +359,7 @@ int cross_dot_normals_undecided(const NormalRef& a, const NormalRef& b, const No
       if (value.hi < -bound) return -1;
     }
   }
-  return CGAL::sign(cross_dot(a.exact(), b.exact(), c.exact(), d.exact()));
+  return kUndecided;
 }
 
 namespace {

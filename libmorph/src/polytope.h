@@ -228,14 +228,25 @@ struct NormalRef {
 /// ulp): about 7e-15, doubled for safety.
 inline constexpr double kUnitPredicateRounding = 2e-14;
 
+/// What a stage of a predicate returns when it cannot tell the sign.
+inline constexpr int kUndecided = 2;
+
 /// The later stages, for what the double filter leaves undecided: double-double, then
 /// exact.
 int orient_normals_undecided(const NormalRef& a, const NormalRef& b, const NormalRef& c);
 int cross_dot_normals_undecided(const NormalRef& a, const NormalRef& b, const NormalRef& c,
                                 const NormalRef& d);
+/// Each stage alone (for callers with shortcuts of their own between them, gauss_map.h):
+/// the double-double stage returns the sign or kUndecided; the exact stage, the sign.
+int orient_normals_precise(const NormalRef& a, const NormalRef& b, const NormalRef& c);
+int orient_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef& c);
+int cross_dot_normals_precise(const NormalRef& a, const NormalRef& b, const NormalRef& c,
+                              const NormalRef& d);
+int cross_dot_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef& c,
+                            const NormalRef& d);
 
-/// Sign of det(N_a, N_b, N_c).
-inline int orient_normals(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
+/// The double filter of orient_normals alone: the sign, or kUndecided.
+inline int orient_normals_filter(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
   const UnitNormal &p = a.unit(), &q = b.unit(), &r = c.unit();
   const double d =
       p.x * (q.y * r.z - q.z * r.y) + p.y * (q.z * r.x - q.x * r.z) + p.z * (q.x * r.y - q.y * r.x);
@@ -243,12 +254,18 @@ inline int orient_normals(const NormalRef& a, const NormalRef& b, const NormalRe
   const double bound = p.error + q.error + r.error + kUnitPredicateRounding;
   if (d > bound) return 1;
   if (d < -bound) return -1;
-  return orient_normals_undecided(a, b, c);
+  return kUndecided;
 }
 
-/// Sign of (N_a x N_b) . (N_c x N_d) = (N_a.N_c)(N_b.N_d) - (N_a.N_d)(N_b.N_c).
-inline int cross_dot_normals(const NormalRef& a, const NormalRef& b, const NormalRef& c,
-                             const NormalRef& d) {
+/// Sign of det(N_a, N_b, N_c).
+inline int orient_normals(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
+  const int s = orient_normals_filter(a, b, c);
+  return s != kUndecided ? s : orient_normals_undecided(a, b, c);
+}
+
+/// The double filter of cross_dot_normals alone: the sign, or kUndecided.
+inline int cross_dot_normals_filter(const NormalRef& a, const NormalRef& b, const NormalRef& c,
+                                    const NormalRef& d) {
   const UnitNormal &p = a.unit(), &q = b.unit(), &r = c.unit(), &s = d.unit();
   auto dot3 = [](const UnitNormal& u, const UnitNormal& v) {
     return u.x * v.x + u.y * v.y + u.z * v.z;
@@ -259,7 +276,14 @@ inline int cross_dot_normals(const NormalRef& a, const NormalRef& b, const Norma
   const double bound = 2 * e + 4 * e * e + kUnitPredicateRounding;
   if (value > bound) return 1;
   if (value < -bound) return -1;
-  return cross_dot_normals_undecided(a, b, c, d);
+  return kUndecided;
+}
+
+/// Sign of (N_a x N_b) . (N_c x N_d) = (N_a.N_c)(N_b.N_d) - (N_a.N_d)(N_b.N_c).
+inline int cross_dot_normals(const NormalRef& a, const NormalRef& b, const NormalRef& c,
+                             const NormalRef& d) {
+  const int s = cross_dot_normals_filter(a, b, c, d);
+  return s != kUndecided ? s : cross_dot_normals_undecided(a, b, c, d);
 }
 
 /// How make_polytope reads a mesh's faces: as given, or each reversed (an inverted mesh,
