@@ -221,12 +221,8 @@ HVertex vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& ab
   return v;
 }
 
-/// A vertex of three planes taken from a known point when the three pass through one (and
-/// their normals are independent: the meet is then that point).
-void take_known(const KnownPoints& known, HVertex& v) {
-  if (known.empty() || !(v.Wi.inf() > 0)) return;
-  const int k = known.common(v.planes[0], v.planes[1], v.planes[2]);
-  if (k < 0) return;
+/// Makes v known point k, with its exact coordinates.
+void set_known(const KnownPoints& known, int k, HVertex& v) {
   v.known = k;
   v.Xi = known.Xi[k];
   v.Wi = known.Wi[k];
@@ -234,6 +230,14 @@ void take_known(const KnownPoints& known, HVertex& v) {
   v.X = known.X[k];
   v.W = known.W[k];
   v.has_exact = true;
+}
+
+/// A vertex of three planes taken from a known point when the three pass through one (and
+/// their normals are independent: the meet is then that point).
+void take_known(const KnownPoints& known, HVertex& v) {
+  if (known.empty() || !(v.Wi.inf() > 0)) return;
+  const int k = known.common(v.planes[0], v.planes[1], v.planes[2]);
+  if (k >= 0) set_known(known, k, v);
 }
 /// The vertex of three planes, from a known point where there is one (take_known).
 HVertex vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& abc,
@@ -252,13 +256,7 @@ HVertex independent_vertex_of(const std::vector<Plane>& planes, const std::array
   if (k < 0) return vertex_of(planes, abc, known);
   HVertex v;
   v.planes = abc;
-  v.known = k;
-  v.Xi = known.Xi[k];
-  v.Wi = known.Wi[k];
-  v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
-  v.X = known.X[k];
-  v.W = known.W[k];
-  v.has_exact = true;
+  set_known(known, k, v);
   return v;
 }
 
