@@ -23,12 +23,15 @@ struct HalfedgeArrays {
                   "OpenMesh's array items are not plain handles");
     if (mesh.n_halfedges() > 0) {
       halfedge = reinterpret_cast<const int*>(&mesh.halfedge(Mesh::HalfedgeHandle(0)));
-      // The field order is fixed by OpenMesh's ArrayItems; checked once on a real halfedge.
-      const Mesh::HalfedgeHandle h(0);
-      if (face(0) != mesh.face_handle(h).idx() || to(0) != mesh.to_vertex_handle(h).idx() ||
-          next(0) != mesh.next_halfedge_handle(h).idx() ||
-          prev(0) != mesh.prev_halfedge_handle(h).idx())
-        throw error("internal error: unexpected layout of OpenMesh's halfedges");
+      // The field order is fixed by OpenMesh's ArrayItems; checked on the first and the
+      // last halfedge (one could hold equal values in two fields by chance).
+      for (const int i : {0, static_cast<int>(mesh.n_halfedges()) - 1}) {
+        const Mesh::HalfedgeHandle h(i);
+        if (face(i) != mesh.face_handle(h).idx() || to(i) != mesh.to_vertex_handle(h).idx() ||
+            next(i) != mesh.next_halfedge_handle(h).idx() ||
+            prev(i) != mesh.prev_halfedge_handle(h).idx())
+          throw error("internal error: unexpected layout of OpenMesh's halfedges");
+      }
     }
     if (mesh.n_vertices() > 0)
       vertex_halfedge = reinterpret_cast<const int*>(&mesh.vertex(Mesh::VertexHandle(0)));
