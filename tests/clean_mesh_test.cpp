@@ -153,7 +153,7 @@ TEST_CASE("clean_mesh rebuilds soups that are not closed manifolds") {
 // parallelogram 0, m, 1, m' (two nearly parallel edges of the operands summed), whose short
 // diagonal m-m' is below the feature size. Merging m and m' folds it onto the edge 0-1: it
 // goes, its sides meet, and the result is the cube without the hull. The same soup with a
-// facet missing still needs the hull.
+// facet missing still needs the hull, and so does the soup far from the origin.
 TEST_CASE("clean_mesh drops a needle folded by its short diagonal without the hull") {
   std::vector<V3<double>> points = cube_points();
   points.push_back({0.5, 0, 0});          // 8: m
@@ -188,6 +188,14 @@ TEST_CASE("clean_mesh drops a needle folded by its short diagonal without the hu
     for (std::size_t i = 6; i < open_begin.size(); ++i) open_begin[i] -= 4;
     check_cube(clean_mesh(points, open_begin, open_corners, &source));
     CHECK(morph::detail::clean_mesh_hull_fallbacks() == before + 1);
+    // Far from the origin, where the points' rounding unit exceeds the feature size (m' is
+    // m there): left to the hull, as before.
+    std::vector<V3<double>> far = points;
+    for (auto& p : far) p = {p.x + 0x1p40, p.y, p.z};
+    const morph::Mesh mesh = clean_mesh(far, begin, corners, &source);
+    CHECK(mesh.n_vertices() == 8);
+    CHECK(mesh.n_faces() == 6);
+    CHECK(morph::detail::clean_mesh_hull_fallbacks() == before + 2);
   }
 }
 

@@ -4,7 +4,7 @@
 // Three passes, each linear in the size of the result:
 //   1. corners of a facet closer than the feature size are merged (clusters); a facet
 //      folded onto itself by that (a needle whose short diagonal merged) loses its loops of
-//      fewer than three corners;
+//      fewer than three corners, when the points are finer than the feature size;
 //   2. adjacent facets that are coplanar to within the feature size are grouped, and a
 //      facet thinner than the feature size (a needle: two nearly parallel edges of the
 //      operands summed) joins a neighbour it is flat against;
@@ -780,6 +780,13 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
   }
   const V3<double> span = hi - lo;
   const double limit = kFeatureTolerance * std::sqrt(dot(span, span));
+  // Points whose rounding unit exceeds the feature size (a result far from the origin for
+  // its size) carry noise that merging cannot remove; the hull drops what of it is not
+  // extreme, and gives a simpler mesh there. So a facet folded onto itself is split only
+  // when the points are finer than the feature size, and otherwise left to the hull.
+  const double magnitude = std::max({std::abs(lo.x), std::abs(lo.y), std::abs(lo.z), std::abs(hi.x),
+                                     std::abs(hi.y), std::abs(hi.z)});
+  const bool fine = magnitude * std::numeric_limits<double>::epsilon() <= limit;
   // Pass 1: clusters of close corners, each represented by its lowest vertex.
   UnionFind clusters(n);
   // Squared distances above `far` are beyond `limit` whatever the rounding of its square
@@ -865,7 +872,7 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
         twice = twice || last_facet[v] == f;
         last_facet[v] = f;
       }
-      if (twice && !split_collapsed(cycle, place)) repeated = true;
+      if (twice && !(fine && split_collapsed(cycle, place))) repeated = true;
       if (cycle.size() >= 3) soup.add(cycle, f);
     }
   }
