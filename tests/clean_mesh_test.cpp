@@ -1,14 +1,19 @@
 // White-box test of the assembly's last step: facets over rounded points to a clean mesh.
 #include <doctest/doctest.h>
+#include <morph/io.h>
+#include <morph/minkowski_sum.h>
 
 #include <algorithm>
 #include <array>
 #include <map>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "fims.h"
 #include "parallel.h"
+#include "support/oracle.h"
+#include "support/polytopes.h"
 
 namespace {
 
@@ -141,6 +146,108 @@ TEST_CASE("clean_mesh rebuilds soups that are not closed manifolds") {
     corners = cube_soup(split, {}, begin);
     std::reverse(corners.end() - 4, corners.end());
     check_cube(clean_mesh(points, begin, corners, &source));
+  }
+}
+
+// The unit cube whose front (y = 0) and bottom (z = 0) meet through a needle: a thin
+// parallelogram 0, m, 1, m' (two nearly parallel edges of the operands summed), whose short
+// diagonal m-m' is below the feature size. Merging m and m' folds it onto the edge 0-1: it
+// goes, its sides meet, and the result is the cube without the hull. The same soup with a
+// facet missing still needs the hull, and so does the soup far from the origin.
+TEST_CASE("clean_mesh drops a needle folded by its short diagonal without the hull") {
+  std::vector<V3<double>> points = cube_points();
+  points.push_back({0.5, 0, 0});          // 8: m
+  points.push_back({0.5 + 1e-13, 0, 0});  // 9: m', within the feature size of m
+  for (const std::vector<int>& needle :
+       {std::vector<int>{0, 8, 1, 9}, std::vector<int>{8, 1, 9, 0}}) {
+    const std::vector<std::vector<int>> facets = {
+        {0, 2, 3, 1, 8},  // bottom: 1 -> m -> 0
+        {4, 5, 7, 6},     // top
+        {0, 9, 1, 5, 4},  // front: 0 -> m' -> 1
+        {2, 6, 7, 3},     // back
+        {0, 4, 6, 2},     // left
+        {1, 3, 7, 5},     // right
+        needle,
+    };
+    std::vector<int> begin{0}, corners;
+    for (const auto& f : facets) {
+      corners.insert(corners.end(), f.begin(), f.end());
+      begin.push_back(static_cast<int>(corners.size()));
+    }
+    CAPTURE(needle);
+    std::vector<int> source;
+    const long before = morph::detail::clean_mesh_hull_fallbacks();
+    check_cube(clean_mesh(points, begin, corners, &source));
+    CHECK(morph::detail::clean_mesh_hull_fallbacks() == before);
+    CHECK(source.size() == 6);
+    CHECK(std::find(source.begin(), source.end(), 6) == source.end());  // not the needle's
+    // The right face missing: not a closed manifold once folded either.
+    std::vector<int> open_corners = corners, open_begin = begin;
+    open_corners.erase(open_corners.begin() + begin[5], open_corners.begin() + begin[6]);
+    open_begin.erase(open_begin.begin() + 6);
+    for (std::size_t i = 6; i < open_begin.size(); ++i) open_begin[i] -= 4;
+    check_cube(clean_mesh(points, open_begin, open_corners, &source));
+    CHECK(morph::detail::clean_mesh_hull_fallbacks() == before + 1);
+    // Far from the origin, where the points' rounding unit exceeds the feature size (m' is
+    // m there): left to the hull, as before.
+    std::vector<V3<double>> far = points;
+    for (auto& p : far) p = {p.x + 0x1p40, p.y, p.z};
+    const morph::Mesh mesh = clean_mesh(far, begin, corners, &source);
+    CHECK(mesh.n_vertices() == 8);
+    CHECK(mesh.n_faces() == 6);
+    CHECK(morph::detail::clean_mesh_hull_fallbacks() == before + 2);
+  }
+}
+
+// A (+) (A + t) with t rounded: the operands' facets are parallel up to the rounding, and
+// the exact sum has, along every edge of 2A, needles whose short diagonals merge (see the
+// test above). The result is 2A translated, from the regular path (no hull), and agrees
+// with the exact oracle to within the feature size.
+TEST_CASE("clean_mesh: a sum with a rounded translate of itself takes the regular path") {
+  using namespace morph::test;
+  const morph::Point t(0.3, -1.7, 2.25);
+  struct Case {
+    std::string name;
+    morph::Mesh A, B;
+  };
+  std::vector<Case> cases;
+  const morph::Mesh ico = morph::read_mesh(std::string(MORPH_SAMPLES_DIR) + "/icosphere_320.off");
+  cases.push_back({"icosphere_320 + translate", ico, translated(ico, t)});
+  cases.push_back(
+      {"icosphere_320 + translate of its reflection", ico, translated(reflected(ico), t)});
+  const morph::Mesh hull =
+      morph::read_mesh(std::string(MORPH_SAMPLES_DIR) + "/random_hull_200.off");
+  cases.push_back({"random_hull_200 + translate", hull, translated(hull, t)});
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    const morph::Mesh A = random_sphere_polytope(60, 1100 + seed);
+    cases.push_back({"sphere hull + translate seed " + std::to_string(seed), A,
+                     translated(A, morph::Point(-7.125 + 0.1 * seed, 0.7, 1e3))});
+  }
+  for (const Case& c : cases) {
+    CAPTURE(c.name);
+    const long before = morph::detail::clean_mesh_hull_fallbacks();
+    const morph::LabelledMesh S = morph::minkowski_sum(c.A, c.B);
+    CHECK(morph::detail::clean_mesh_hull_fallbacks() == before);
+    // 2A translated (the icosphere is its own reflection).
+    CHECK(S.mesh.n_vertices() == c.A.n_vertices());
+    CHECK(S.mesh.n_faces() == c.A.n_faces());
+    const Description want = exact_hull_of_sums(c.A, c.B);
+    const Description got = describe(S.mesh);
+    const double diagonal = bbox_diagonal(S.mesh);
+    std::set<Position> sums;
+    for (auto va : c.A.vertices())
+      for (auto vb : c.B.vertices()) {
+        const morph::Point s = c.A.point(va) + c.B.point(vb);
+        sums.insert({s[0], s[1], s[2]});
+      }
+    CHECK(std::all_of(got.vertices.begin(), got.vertices.end(),
+                      [&](const Position& p) { return sums.count(p) == 1; }));
+    const std::string diff = compare_close(got, want, kLibraryFeatureTolerance * diagonal, 1e-12);
+    CHECK_MESSAGE(diff.empty(), diff);
+    const std::string left = subresolution_feature(got, kResultFeatureTolerance * diagonal);
+    CHECK_MESSAGE(left.empty(), "the result has ", left);
+    const std::string clean = clean_mesh_problem(S.mesh, kRoundedClean);
+    CHECK_MESSAGE(clean.empty(), clean);
   }
 }
 

@@ -2,7 +2,9 @@
 // points) to a clean mesh, merging features below double precision.
 //
 // Three passes, each linear in the size of the result:
-//   1. corners of a facet closer than the feature size are merged (clusters);
+//   1. corners of a facet closer than the feature size are merged (clusters); a facet
+//      folded onto itself by that (a needle whose short diagonal merged) loses its loops of
+//      fewer than three corners, when the points are finer than the feature size;
 //   2. adjacent facets that are coplanar to within the feature size are grouped, and a
 //      facet thinner than the feature size (a needle: two nearly parallel edges of the
 //      operands summed) joins a neighbour it is flat against;
@@ -722,7 +724,48 @@ Soup hull_facets(const std::vector<V3<double>>& points, const Soup& facets) {
   return out;
 }
 
+/// A cycle of pass 1 that passes a point twice, split there into loops: a facet whose close
+/// corners merged across it (the short diagonal of a thin parallelogram: two nearly
+/// parallel edges of the operands summed) folds onto itself. Loops of fewer than three
+/// points are collapsed onto an edge, whose two sides then meet, like a collapsed facet's
+/// neighbours; `cycle` becomes the one loop left (empty if none). False when more than one
+/// loop is left: the facet is pinched into several polygons, which the hull then decides.
+/// `place` is all -1 for the points (grown as needed), and is left so.
+bool split_collapsed(std::vector<int>& cycle, std::vector<int>& place) {
+  std::vector<int> stack, kept;
+  int loops = 0;
+  for (const int v : cycle) {
+    if (v >= static_cast<int>(place.size())) place.resize(v + 1, -1);
+    if (place[v] >= 0) {
+      // The loop from v's first visit to here: off the stack (v stays on it).
+      const int from = place[v] + 1;
+      if (static_cast<int>(stack.size()) - from + 1 >= 3) {
+        ++loops;
+        kept.assign(stack.begin() + from - 1, stack.end());
+      }
+      for (int i = from; i < static_cast<int>(stack.size()); ++i) place[stack[i]] = -1;
+      stack.resize(from);
+      continue;
+    }
+    place[v] = static_cast<int>(stack.size());
+    stack.push_back(v);
+  }
+  for (const int v : stack) place[v] = -1;
+  // What is left on the stack is the loop that the cycle's closing edge ends.
+  if (stack.size() >= 3) {
+    ++loops;
+    kept = std::move(stack);
+  }
+  if (loops > 1) return false;
+  cycle = std::move(kept);
+  return true;
+}
+
+std::atomic<long> hull_fallbacks{0};
+
 }  // namespace
+
+long clean_mesh_hull_fallbacks() { return hull_fallbacks.load(std::memory_order_relaxed); }
 
 Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& face_begin,
                 std::vector<int> corners, std::vector<int>* source) {
@@ -737,6 +780,13 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
   }
   const V3<double> span = hi - lo;
   const double limit = kFeatureTolerance * std::sqrt(dot(span, span));
+  // Points whose rounding unit exceeds the feature size (a result far from the origin for
+  // its size) carry noise that merging cannot remove; the hull drops what of it is not
+  // extreme, and gives a simpler mesh there. So a facet folded onto itself is split only
+  // when the points are finer than the feature size, and otherwise left to the hull.
+  const double magnitude = std::max({std::abs(lo.x), std::abs(lo.y), std::abs(lo.z), std::abs(hi.x),
+                                     std::abs(hi.y), std::abs(hi.z)});
+  const bool fine = magnitude * std::numeric_limits<double>::epsilon() <= limit;
   // Pass 1: clusters of close corners, each represented by its lowest vertex.
   UnionFind clusters(n);
   // Squared distances above `far` are beyond `limit` whatever the rounding of its square
@@ -808,7 +858,7 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
     last_facet.assign(n, -1);
     soup.vertex.reserve(corners.size());
     soup.source.reserve(nf);
-    std::vector<int> cycle;
+    std::vector<int> cycle, place;  // place: of a point in `cycle` while it is split (-1: none)
     for (int f = 0; f < nf; ++f) {
       cycle.clear();
       for (int c = face_begin[f]; c < face_begin[f + 1]; ++c) {
@@ -817,16 +867,19 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
       }
       while (cycle.size() > 1 && cycle.front() == cycle.back()) cycle.pop_back();
       if (cycle.size() < 3) continue;  // collapsed onto an edge or a point: its neighbours meet
-      for (std::size_t i = 0; i < cycle.size() && !repeated; ++i) {
-        repeated = last_facet[cycle[i]] == f;
-        last_facet[cycle[i]] = f;
+      bool twice = false;
+      for (const int v : cycle) {
+        twice = twice || last_facet[v] == f;
+        last_facet[v] = f;
       }
-      soup.add(cycle, f);
+      if (twice && !(fine && split_collapsed(cycle, place))) repeated = true;
+      if (cycle.size() >= 3) soup.add(cycle, f);
     }
   }
   std::optional<std::pair<Soup, Connectivity>> result;
   if (!repeated) result = simplify(points, soup, limit, true);
   if (!result) {
+    hull_fallbacks.fetch_add(1, std::memory_order_relaxed);
     Soup hull = hull_facets(points, soup);
     result = simplify(points, hull, limit, false);
   }

@@ -65,4 +65,8 @@ inline constexpr double kFeatureTolerance = 1e-11;
 Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& face_begin,
                 std::vector<int> corners, std::vector<int>* source);
 
+/// How many times clean_mesh has rebuilt a result from the hull of its points (for tests:
+/// which inputs take that slow path).
+long clean_mesh_hull_fallbacks();
+
 }  // namespace morph::detail
