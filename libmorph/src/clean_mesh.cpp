@@ -563,6 +563,81 @@ std::optional<std::pair<Soup, Connectivity>> simplify(const std::vector<V3<doubl
   return std::make_pair(std::move(soup), std::move(*k));
 }
 
+// From this many corners with two threads or more, `build` fills the mesh in parallel.
+constexpr int kParallelBuildCorners = 16384;
+
+/// `build` in parallel passes, with the same numbering: an edge is numbered by the corners
+/// before its first corner that are first corners of their edges (twin[c] >= c), counted in
+/// fixed blocks of corners (a prefix sum over the blocks, so the numbers do not depend on
+/// the threads); a vertex's halfedge is its last corner's, found in the serial pass that
+/// marks the used points.
+Mesh build_parallel(const std::vector<V3<double>>& points, const Soup& soup,
+                    const Connectivity& k) {
+  Mesh mesh;
+  const int nc = static_cast<int>(soup.vertex.size());
+  const int np = static_cast<int>(points.size());
+  constexpr int kBlock = 4096;  // corners
+  const int nb = (nc + kBlock - 1) / kBlock;
+  std::vector<int> last(np, -1);  // the last corner at each point (-1: unused)
+  std::vector<int> block_edges(nb + 1, 0);  // the first edge of each block
+  const int* vertex = soup.vertex.data();
+  const int* twin = k.twin.data();
+  // Serial: a plain store per corner (the last one wins), cheaper than any atomic maximum.
+  for (int c = 0; c < nc; ++c) last[vertex[c]] = c;
+  parallel_chunks(nb, 1, [&](int first, int end) {
+    for (int b = first; b < end; ++b) {
+      int n = 0;
+      for (int c = b * kBlock; c < std::min(nc, (b + 1) * kBlock); ++c) n += twin[c] >= c;
+      block_edges[b + 1] = n;
+    }
+  });
+  std::partial_sum(block_edges.begin(), block_edges.end(), block_edges.begin());
+  std::vector<int> handle(np);  // the mesh vertex of each point (unused points: not read)
+  int num_used = 0;
+  for (int v = 0; v < np; ++v)
+    if (last[v] >= 0) handle[v] = num_used++;
+  mesh.resize(num_used, block_edges[nb], soup.size());
+  Point* point = mesh.property(mesh.points_pph()).data_vector().data();
+  Ints halfedge(nc);  // of each corner
+  const auto vh = [&](int c) { return Mesh::VertexHandle(handle[vertex[c]]); };
+  const auto he = [&](int c) { return Mesh::HalfedgeHandle(halfedge[c]); };
+  // The first corners of edges: their halfedges (2e for edge e) and both halfedges' vertices.
+  parallel_chunks(nb, 1, [&](int first, int end) {
+    for (int b = first; b < end; ++b) {
+      int edge = block_edges[b];
+      for (int c = b * kBlock; c < std::min(nc, (b + 1) * kBlock); ++c) {
+        if (twin[c] < c) continue;
+        halfedge[c] = mesh.halfedge_handle(Mesh::EdgeHandle(edge++), 0).idx();
+        mesh.set_vertex_handle(he(c), vh(k.next[c]));
+        mesh.set_vertex_handle(mesh.opposite_halfedge_handle(he(c)), vh(c));
+      }
+    }
+  });
+  // The other corners (their twins' opposites), then each face's halfedges.
+  parallel_chunks(soup.size(), kFacetGrain, [&](int first, int end) {
+    for (int f = first; f < end; ++f) {
+      const int b = soup.begin[f], e = soup.begin[f + 1];
+      for (int c = b; c < e; ++c)
+        if (twin[c] < c) halfedge[c] = mesh.opposite_halfedge_handle(he(twin[c])).idx();
+      const Mesh::FaceHandle fh(f);
+      for (int c = b; c < e; ++c) {
+        mesh.set_face_handle(he(c), fh);
+        mesh.set_next_halfedge_handle(he(c), he(k.next[c]));
+      }
+      mesh.set_halfedge_handle(fh, he(e - 1));  // as add_face: the cycle starts at vertex b
+    }
+  });
+  parallel_chunks(np, kVertexGrain, [&](int first, int end) {
+    for (int v = first; v < end; ++v) {
+      if (last[v] < 0) continue;
+      point[handle[v]] = Point(points[v].x, points[v].y, points[v].z);
+      // A vertex's halfedge is its last corner's (as when faces are added in order).
+      mesh.set_halfedge_handle(Mesh::VertexHandle(handle[v]), he(last[v]));
+    }
+  });
+  return mesh;
+}
+
 /// The OpenMesh mesh of a closed manifold soup, built straight from its connectivity
 /// (no per-face searches). Vertices in index order, faces in soup order, each face's
 /// vertex cycle starting where the soup's does.
@@ -570,6 +645,9 @@ Mesh build(const std::vector<V3<double>>& points, const Soup& soup, const Connec
   Mesh mesh;
   const int nc = static_cast<int>(soup.vertex.size());
   const int np = static_cast<int>(points.size());
+  // Large results with threads to spare: build_parallel, the same arrays in parallel passes.
+  if (nc >= kParallelBuildCorners && tbb::this_task_arena::max_concurrency() > 1)
+    return build_parallel(points, soup, k);
   std::vector<int> handle(np, -1);  // the mesh vertex of each point (-1: unused)
   int num_edges = 0;
   for (int c = 0; c < nc; ++c) {
