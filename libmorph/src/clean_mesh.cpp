@@ -578,7 +578,7 @@ Mesh build_parallel(const std::vector<V3<double>>& points, const Soup& soup,
   const int np = static_cast<int>(points.size());
   constexpr int kBlock = 4096;  // corners
   const int nb = (nc + kBlock - 1) / kBlock;
-  std::vector<int> last(np, -1);  // the last corner at each point (-1: unused)
+  std::vector<int> last(np, -1);            // the last corner at each point (-1: unused)
   std::vector<int> block_edges(nb + 1, 0);  // the first edge of each block
   const int* vertex = soup.vertex.data();
   const int* twin = k.twin.data();

@@ -446,7 +446,8 @@ void index_vertices(const SumFacets& facets, int num_a, int num_b,
   // The numbers do not depend on how the buckets are split between threads.
   const auto distinct = std::make_unique_for_overwrite<int[]>(nc);
   std::vector<int> count(num_a + 1);
-  tbb::enumerable_thread_specific<std::vector<int>> slots([&] { return std::vector<int>(num_b, -1); });
+  tbb::enumerable_thread_specific<std::vector<int>> slots(
+      [&] { return std::vector<int>(num_b, -1); });
   // About kCornerGrain corners a chunk (the buckets have about nc / num_a corners each).
   constexpr int kCornerGrain = 4096;
   const int grain = std::max(1, static_cast<int>(std::int64_t{num_a} * kCornerGrain / nc));
