@@ -216,9 +216,9 @@ TEST_CASE("clean_mesh merges large grids of nearly coplanar facets alike with 1 
 // for element, down to each vertex's halfedge (a vertex's halfedge is its last corner's).
 TEST_CASE("sum_mesh numbers and builds large results alike with 1 and 2 threads") {
   using morph::Mesh;
-  const Mesh A = morph::make_icosphere(1.0, 4);  // 5120 triangles
+  const Mesh A = morph::make_icosphere(1.0, 5);  // 20480 triangles
   const Mesh B =
-      morph::test::transformed(morph::make_icosphere(0.7, 4), morph::test::random_rotation(7));
+      morph::test::transformed(morph::make_icosphere(0.7, 5), morph::test::random_rotation(7));
   const morph::detail::Polytope pa = morph::detail::make_operand(A, "A");
   const morph::detail::Polytope pb = morph::detail::make_operand(B, "B");
   const auto run = [&](int threads, std::vector<std::uint64_t>& pairs, std::vector<int>& corners) {
@@ -232,7 +232,8 @@ TEST_CASE("sum_mesh numbers and builds large results alike with 1 and 2 threads"
   std::vector<int> corners1, corners2;
   const morph::LabelledMesh one = run(1, pairs1, corners1);
   const morph::LabelledMesh two = run(2, pairs2, corners2);
-  REQUIRE(corners1.size() > 16384);  // above both parallel thresholds (kParallelCorners)
+  // Above both parallel thresholds (kParallelCorners, kParallelBuildCorners: 2^17 corners).
+  REQUIRE(corners1.size() > (1u << 17));
   CHECK(pairs1 == pairs2);
   CHECK(corners1 == corners2);
   const Mesh &m1 = one.mesh, &m2 = two.mesh;

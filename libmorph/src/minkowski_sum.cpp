@@ -412,8 +412,8 @@ void index_vertices(const SumFacets& facets, int num_a, int num_b,
   }
   corners.resize(nc);
   // Large results with threads to spare: the buckets are numbered in two parallel passes
-  // (below); otherwise in one.
-  constexpr int kParallelCorners = 16384;
+  // (below); otherwise in one (a single pass over memory, faster below this size).
+  constexpr int kParallelCorners = 1 << 17;
   if (nc < kParallelCorners || tbb::this_task_arena::max_concurrency() == 1) {
     std::vector<int> slot(num_b, -1);  // pair index of (i, j) while bucket i is numbered
     const auto partners = std::make_unique_for_overwrite<int[]>(num_b);  // of bucket i, distinct
