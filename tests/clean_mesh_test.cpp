@@ -2,6 +2,7 @@
 #include <doctest/doctest.h>
 #include <morph/io.h>
 #include <morph/minkowski_sum.h>
+#include <morph/structuring_element.h>
 
 #include <algorithm>
 #include <array>
@@ -12,6 +13,7 @@
 
 #include "fims.h"
 #include "parallel.h"
+#include "polytope.h"
 #include "support/oracle.h"
 #include "support/polytopes.h"
 
@@ -313,6 +315,63 @@ TEST_CASE("clean_mesh merges large grids of nearly coplanar facets alike with 1 
     for (auto v : two.fv_range(morph::Mesh::FaceHandle(f.idx()))) b.push_back(v.idx());
     CHECK(a == b);
   }
+}
+
+// Large results are numbered (index_vertices) and built into OpenMesh's arrays (build) by
+// parallel passes when there are threads; they must give the serial passes' mesh, element
+// for element, down to each vertex's halfedge (a vertex's halfedge is its last corner's).
+TEST_CASE("sum_mesh numbers and builds large results alike with 1 and 2 threads") {
+  using morph::Mesh;
+  const Mesh A = morph::make_icosphere(1.0, 5);  // 20480 triangles
+  const Mesh B =
+      morph::test::transformed(morph::make_icosphere(0.7, 5), morph::test::random_rotation(7));
+  const morph::detail::Polytope pa = morph::detail::make_operand(A, "A");
+  const morph::detail::Polytope pb = morph::detail::make_operand(B, "B");
+  const auto run = [&](int threads, std::vector<std::uint64_t>& pairs, std::vector<int>& corners) {
+    return morph::detail::run_with_threads(threads, [&] {
+      const morph::detail::SumFacets facets = morph::detail::fims_facets(pa, pb);
+      morph::detail::index_vertices(facets, pa.num_vertices(), pb.num_vertices(), pairs, corners);
+      return morph::detail::sum_mesh(pa, pb, facets);
+    });
+  };
+  std::vector<std::uint64_t> pairs1, pairs2;
+  std::vector<int> corners1, corners2;
+  const morph::LabelledMesh one = run(1, pairs1, corners1);
+  const morph::LabelledMesh two = run(2, pairs2, corners2);
+  // Above both parallel thresholds (kParallelCorners, kParallelBuildCorners: 2^17 corners).
+  REQUIRE(corners1.size() > (1u << 17));
+  CHECK(pairs1 == pairs2);
+  CHECK(corners1 == corners2);
+  const Mesh &m1 = one.mesh, &m2 = two.mesh;
+  REQUIRE(m1.n_vertices() == m2.n_vertices());
+  REQUIRE(m1.n_edges() == m2.n_edges());
+  REQUIRE(m1.n_faces() == m2.n_faces());
+  REQUIRE(one.origins.size() == two.origins.size());
+  int differing = 0;
+  for (auto v : m1.vertices()) {
+    const Mesh::VertexHandle w(v.idx());
+    differing += m1.point(v) != m2.point(w) || m1.halfedge_handle(v) != m2.halfedge_handle(w);
+  }
+  for (auto h : m1.halfedges()) {
+    const Mesh::HalfedgeHandle g(h.idx());
+    differing += m1.to_vertex_handle(h) != m2.to_vertex_handle(g) ||
+                 m1.face_handle(h) != m2.face_handle(g) ||
+                 m1.next_halfedge_handle(h) != m2.next_halfedge_handle(g) ||
+                 m1.prev_halfedge_handle(h) != m2.prev_halfedge_handle(g);
+  }
+  for (auto f : m1.faces())
+    differing += m1.halfedge_handle(f) != m2.halfedge_handle(Mesh::FaceHandle(f.idx()));
+  for (std::size_t f = 0; f < one.origins.size(); ++f) {
+    const auto &x = one.origins[f], &y = two.origins[f];
+    differing += x.kind != y.kind || x.a.kind != y.a.kind || x.a.index != y.a.index ||
+                 x.b.kind != y.b.kind || x.b.index != y.b.index;
+  }
+  CHECK(differing == 0);
+  // A closed mesh whose vertex halfedges leave their vertex, as OpenMesh's own add_face.
+  int bad = 0;
+  for (auto h : m1.halfedges()) bad += m1.is_boundary(h);
+  for (auto v : m1.vertices()) bad += m1.from_vertex_handle(m1.halfedge_handle(v)) != v;
+  CHECK(bad == 0);
 }
 
 // A prism over an L-shaped hexagon (not convex: its top and bottom are not convex polygons),

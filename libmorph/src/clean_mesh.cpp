@@ -565,10 +565,93 @@ std::optional<std::pair<Soup, Connectivity>> simplify(const std::vector<V3<doubl
   return std::make_pair(std::move(soup), std::move(*k));
 }
 
+// From this many corners with two threads or more, `build` fills the mesh in parallel. Its
+// passes do about 1.3 times the work of build_serial's one pass (with OpenMesh's resize,
+// which stays serial, their best case at two threads is about 18% less time), and below
+// this they were slower with two threads on a loaded machine (see docs/algorithm.md).
+constexpr int kParallelBuildCorners = 1 << 17;
+
+/// `build` in parallel passes, with the same numbering: an edge is numbered by the corners
+/// before its first corner that are first corners of their edges (twin[c] >= c), counted in
+/// fixed blocks of corners (a prefix sum over the blocks, so the numbers do not depend on
+/// the threads); a vertex's halfedge is its last corner's, found in the serial pass that
+/// marks the used points.
+Mesh build_parallel(const std::vector<V3<double>>& points, const Soup& soup,
+                    const Connectivity& k) {
+  Mesh mesh;
+  const int nc = static_cast<int>(soup.vertex.size());
+  const int np = static_cast<int>(points.size());
+  constexpr int kBlock = 4096;  // corners
+  const int nb = (nc + kBlock - 1) / kBlock;
+  std::vector<int> last(np, -1);            // the last corner at each point (-1: unused)
+  std::vector<int> block_edges(nb + 1, 0);  // the first edge of each block
+  const int* vertex = soup.vertex.data();
+  const int* twin = k.twin.data();
+  // Serial: a plain store per corner (the last one wins), cheaper than any atomic maximum.
+  for (int c = 0; c < nc; ++c) last[vertex[c]] = c;
+  parallel_chunks(nb, 1, [&](int first, int end) {
+    for (int b = first; b < end; ++b) {
+      int n = 0;
+      for (int c = b * kBlock; c < std::min(nc, (b + 1) * kBlock); ++c) n += twin[c] >= c;
+      block_edges[b + 1] = n;
+    }
+  });
+  std::partial_sum(block_edges.begin(), block_edges.end(), block_edges.begin());
+  std::vector<int> handle(np);  // the mesh vertex of each point (unused points: not read)
+  int num_used = 0;
+  for (int v = 0; v < np; ++v)
+    if (last[v] >= 0) handle[v] = num_used++;
+  mesh.resize(num_used, block_edges[nb], soup.size());
+  Point* point = mesh.property(mesh.points_pph()).data_vector().data();
+  Ints halfedge(nc);  // of each corner
+  const auto vh = [&](int c) { return Mesh::VertexHandle(handle[vertex[c]]); };
+  const auto he = [&](int c) { return Mesh::HalfedgeHandle(halfedge[c]); };
+  // The first corners of edges: their halfedges (2e for edge e); then the others (their
+  // twins' opposites).
+  parallel_chunks(nb, 1, [&](int first, int end) {
+    for (int b = first; b < end; ++b) {
+      int edge = block_edges[b];
+      for (int c = b * kBlock; c < std::min(nc, (b + 1) * kBlock); ++c)
+        if (twin[c] >= c) halfedge[c] = mesh.halfedge_handle(Mesh::EdgeHandle(edge++), 0).idx();
+    }
+  });
+  parallel_chunks(nc, kCornerGrain, [&](int first, int end) {
+    for (int c = first; c < end; ++c)
+      if (twin[c] < c) halfedge[c] = mesh.opposite_halfedge_handle(he(twin[c])).idx();
+  });
+  // Both halfedges of an edge from its first corner, edge by edge: each thread writes a range
+  // of edges (OpenMesh keeps an edge's halfedges side by side), not both sides of one line.
+  parallel_chunks(nc, kCornerGrain, [&](int first, int end) {
+    for (int c = first; c < end; ++c) {
+      const int t = twin[c];
+      if (t < c) continue;
+      mesh.set_vertex_handle(he(c), vh(k.next[c]));
+      mesh.set_vertex_handle(he(t), vh(c));
+      mesh.set_face_handle(he(c), Mesh::FaceHandle(k.face[c]));
+      mesh.set_face_handle(he(t), Mesh::FaceHandle(k.face[t]));
+      mesh.set_next_halfedge_handle(he(c), he(k.next[c]));  // and the next one's previous
+      mesh.set_next_halfedge_handle(he(t), he(k.next[t]));
+    }
+  });
+  parallel_chunks(soup.size(), kFacetGrain, [&](int first, int end) {
+    for (int f = first; f < end; ++f)  // as add_face: the cycle starts at vertex b
+      mesh.set_halfedge_handle(Mesh::FaceHandle(f), he(soup.begin[f + 1] - 1));
+  });
+  parallel_chunks(np, kVertexGrain, [&](int first, int end) {
+    for (int v = first; v < end; ++v) {
+      if (last[v] < 0) continue;
+      point[handle[v]] = Point(points[v].x, points[v].y, points[v].z);
+      // A vertex's halfedge is its last corner's (as when faces are added in order).
+      mesh.set_halfedge_handle(Mesh::VertexHandle(handle[v]), he(last[v]));
+    }
+  });
+  return mesh;
+}
+
 /// The OpenMesh mesh of a closed manifold soup, built straight from its connectivity
 /// (no per-face searches). Vertices in index order, faces in soup order, each face's
 /// vertex cycle starting where the soup's does.
-Mesh build(const std::vector<V3<double>>& points, const Soup& soup, const Connectivity& k) {
+Mesh build_serial(const std::vector<V3<double>>& points, const Soup& soup, const Connectivity& k) {
   Mesh mesh;
   const int nc = static_cast<int>(soup.vertex.size());
   const int np = static_cast<int>(points.size());
@@ -616,6 +699,16 @@ Mesh build(const std::vector<V3<double>>& points, const Soup& soup, const Connec
     mesh.set_halfedge_handle(fh, he(e - 1));  // as add_face: the cycle starts at vertex b
   }
   return mesh;
+}
+
+/// The OpenMesh mesh of a closed manifold soup: build_parallel for large results with
+/// threads to spare, else build_serial (the same mesh). Returned as temporaries: OpenMesh
+/// meshes have no move constructor, and a named mesh returned from two places is copied.
+Mesh build(const std::vector<V3<double>>& points, const Soup& soup, const Connectivity& k) {
+  if (static_cast<int>(soup.vertex.size()) >= kParallelBuildCorners &&
+      tbb::this_task_arena::max_concurrency() > 1)
+    return build_parallel(points, soup, k);
+  return build_serial(points, soup, k);
 }
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;

@@ -410,30 +410,76 @@ void index_vertices(const SumFacets& facets, int num_a, int num_b,
     by_a[k] = c;
     partner[k] = pair_second(key);
   }
-  std::vector<int> slot(num_b, -1);  // pair index of (i, j) while bucket i is numbered
-  const auto partners = std::make_unique_for_overwrite<int[]>(num_b);  // of bucket i, distinct
-  // At most one pair per corner: filled up to `size` (push_back is not inlined), then copied.
-  const auto found = std::make_unique_for_overwrite<std::uint64_t[]>(nc);
   corners.resize(nc);
-  int size = 0;
-  for (int i = 0; i < num_a; ++i) {
-    int n = 0;
-    for (int k = first[i]; k < first[i + 1]; ++k) {
-      const int j = partner[k];
-      if (slot[j] < 0) {
-        slot[j] = 0;
-        partners[n++] = j;
+  // Large results with threads to spare: the buckets are numbered in two parallel passes
+  // (below); otherwise in one (a single pass over memory, faster below this size).
+  constexpr int kParallelCorners = 1 << 17;
+  if (nc < kParallelCorners || tbb::this_task_arena::max_concurrency() == 1) {
+    std::vector<int> slot(num_b, -1);  // pair index of (i, j) while bucket i is numbered
+    const auto partners = std::make_unique_for_overwrite<int[]>(num_b);  // of bucket i, distinct
+    // At most one pair per corner: filled up to `size` (push_back is not inlined), then copied.
+    const auto found = std::make_unique_for_overwrite<std::uint64_t[]>(nc);
+    int size = 0;
+    for (int i = 0; i < num_a; ++i) {
+      int n = 0;
+      for (int k = first[i]; k < first[i + 1]; ++k) {
+        const int j = partner[k];
+        if (slot[j] < 0) {
+          slot[j] = 0;
+          partners[n++] = j;
+        }
       }
+      std::sort(partners.get(), partners.get() + n);
+      for (int p = 0; p < n; ++p) {
+        slot[partners[p]] = size;
+        found[size++] = pair_key(i, partners[p]);
+      }
+      for (int k = first[i]; k < first[i + 1]; ++k) corners[by_a[k]] = slot[partner[k]];
+      for (int p = 0; p < n; ++p) slot[partners[p]] = -1;
     }
-    std::sort(partners.get(), partners.get() + n);
-    for (int p = 0; p < n; ++p) {
-      slot[partners[p]] = size;
-      found[size++] = pair_key(i, partners[p]);
-    }
-    for (int k = first[i]; k < first[i + 1]; ++k) corners[by_a[k]] = slot[partner[k]];
-    for (int p = 0; p < n; ++p) slot[partners[p]] = -1;
+    pairs.assign(found.get(), found.get() + size);
+    return;
   }
-  pairs.assign(found.get(), found.get() + size);
+  // The same numbering, bucket by bucket in parallel: first each bucket's distinct partners,
+  // sorted, at the front of its range in `distinct`, and each corner's index among them in
+  // place of its partner; then, from the bucket sizes' prefix sums, the pairs and corners.
+  // The numbers do not depend on how the buckets are split between threads.
+  const auto distinct = std::make_unique_for_overwrite<int[]>(nc);
+  std::vector<int> count(num_a + 1);
+  tbb::enumerable_thread_specific<std::vector<int>> slots(
+      [&] { return std::vector<int>(num_b, -1); });
+  // About kCornerGrain corners a chunk (the buckets have about nc / num_a corners each).
+  constexpr int kCornerGrain = 4096;
+  const int grain = std::max(1, static_cast<int>(std::int64_t{num_a} * kCornerGrain / nc));
+  parallel_chunks(num_a, grain, [&](int begin, int end) {
+    std::vector<int>& slot = slots.local();  // all -1 between buckets
+    for (int i = begin; i < end; ++i) {
+      int* const own = distinct.get() + first[i];
+      int n = 0;
+      for (int k = first[i]; k < first[i + 1]; ++k) {
+        const int j = partner[k];
+        if (slot[j] < 0) {
+          slot[j] = 0;
+          own[n++] = j;
+        }
+      }
+      std::sort(own, own + n);
+      for (int p = 0; p < n; ++p) slot[own[p]] = p;
+      for (int k = first[i]; k < first[i + 1]; ++k) partner[k] = slot[partner[k]];
+      for (int p = 0; p < n; ++p) slot[own[p]] = -1;
+      count[i + 1] = n;
+    }
+  });
+  std::partial_sum(count.begin(), count.end(), count.begin());  // count[i]: bucket i's first pair
+  pairs.resize(count[num_a]);
+  parallel_chunks(num_a, grain, [&](int begin, int end) {
+    for (int i = begin; i < end; ++i) {
+      const int base = count[i];
+      const int* const own = distinct.get() + first[i];
+      for (int p = 0; p < count[i + 1] - base; ++p) pairs[base + p] = pair_key(i, own[p]);
+      for (int k = first[i]; k < first[i + 1]; ++k) corners[by_a[k]] = base + partner[k];
+    }
+  });
 }
 
 namespace {
