@@ -206,7 +206,13 @@ std::vector<Pair> random_pairs() {
     pairs.push_back({"sphere A + (-A) seed " + std::to_string(s), A, reflected(A)});
     const Mesh G = random_grid_polytope(24, 750 + s);
     pairs.push_back({"grid A + (A + t) seed " + std::to_string(s), G, translated(G, Point(0.5, -0.25, 3.0))});
+    // Copies scaled by powers of two (exactly: same_normal's similar cycles) and by 0.3.
+    pairs.push_back({"sphere A + 0.5 A seed " + std::to_string(s), A, scaled(A, 0.5)});
+    pairs.push_back({"grid A + (0.25 A + t) seed " + std::to_string(s), G,
+                     translated(scaled(G, 0.25), Point(0.5, -0.25, 3.0))});
+    pairs.push_back({"sphere A + 0.3 A seed " + std::to_string(s), A, scaled(A, 0.3)});
   }
+  pairs.push_back({"icosphere A + 0.5 A", make_icosphere(1.0, 2), scaled(make_icosphere(1.0, 2), 0.5)});
   for (std::uint64_t s = 1; s <= 5; ++s) {
     pairs.push_back({"rotated cube (triangles) + sphere hull seed " + std::to_string(s),
                      rotated_cube_triangles(1.0, 800 + s), random_sphere_polytope(15, 850 + s)});

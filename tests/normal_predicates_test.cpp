@@ -240,8 +240,9 @@ TEST_CASE("normal predicates: a region's slot planes agree with exact evaluation
 }
 
 // same_normal (gauss_map.h) spares the later stages the predicates on exactly coincident
-// normals (A (+) A, A (+) -A, A (+) an exact translate): it must claim equal directions only
-// where they are exactly equal, and the kernel's predicates with that shortcut must still
+// normals (A (+) A, A (+) -A, A (+) an exact translate or a copy scaled by a power of two):
+// it must claim equal directions only where they are exactly equal (not for a copy scaled by
+// 0.3 or -0.5, unless exactly so), and the kernel's predicates with that shortcut must still
 // agree with exact evaluation on triples holding such pairs, also scaled by 2^+-200 and
 // moved far from the origin (where it must claim nothing that is not exact).
 TEST_CASE("normal predicates: same_normal and the kernel's orientations on coincident normals") {
@@ -261,6 +262,23 @@ TEST_CASE("normal predicates: same_normal and the kernel's orientations on coinc
       {"icosphere A + -A (centrally symmetric)", ico320, test::reflected(ico320), true},
       {"integer A + exact translate", integer, test::translated(integer, Point(3, -1, 7)), true},
       {"integer A + -A", integer, test::reflected(integer), false},
+      {"icosphere A + 0.5 A", ico320, test::scaled(ico320, 0.5), true},
+      {"icosphere A + 0.25 A", ico320, test::scaled(ico320, 0.25), true},
+      {"icosphere A + 2 A", ico320, test::scaled(ico320, 2), true},
+      {"icosphere A + 2^-250 A (the smallest supported size)", ico320,
+       test::scaled(ico320, 0x1p-250), true},
+      {"icosphere 2^-250 A + 2^250 A", test::scaled(ico320, 0x1p-250),
+       test::scaled(ico320, 0x1p250), true},
+      {"icosphere A + 2^250 A (the largest supported size)", ico320, test::scaled(ico320, 0x1p250),
+       true},
+      {"integer A + (0.5 A + t)", integer,
+       test::translated(test::scaled(integer, 0.5), Point(3, -1, 7)), true},
+      {"integer A + (8 A + t)", integer,
+       test::translated(test::scaled(integer, 8), Point(-5, 2, 1)), true},
+      {"icosphere A + 0.3 A (rounded)", ico320, test::scaled(ico320, 0.3), false},
+      {"integer A + 0.3 A (rounded)", integer, test::scaled(integer, 0.3), false},
+      {"icosphere A + -0.5 A", ico320, test::reflected(test::scaled(ico320, 0.5)), false},
+      {"integer A + -0.5 A", integer, test::reflected(test::scaled(integer, 0.5)), false},
       {"icosphere A + A, both scaled by 2^200", test::transformed(ico320, up),
        test::transformed(ico320, up), true},
       {"icosphere A + A, both scaled by 2^-200", test::transformed(ico320, down),

@@ -3,6 +3,8 @@
 #include <morph/error.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <string>
 
 #include "parallel.h"
@@ -94,7 +96,7 @@ Location classify(const Polytope& P, int v, const int zeros[2], int nzeros) {
 
 }  // namespace
 
-bool translated_cycles(const Polytope& P, int f, const Polytope& Q, int g) {
+bool similar_cycles(const Polytope& P, int f, const Polytope& Q, int g) {
   const int d = P.degree(f);
   if (Q.degree(g) != d || !P.given_normals.empty() || !Q.given_normals.empty()) return false;
   const V3<double>* const pp = P.points.data();
@@ -149,6 +151,54 @@ bool translated_cycles(const Polytope& P, int f, const Polytope& Q, int g) {
   };
   for (int r = 0; r < d; ++r)
     if (same_edge(r) && (same_points(r) || translates(r))) return true;
+  // Scaled copies: q_{r+k} - q_r = 2^e (p_k - p_0) for all k. Multiplying by 2^e is exact
+  // in any rounding mode when the product is normal (or both are zero), so such edges'
+  // rounded components are those of p's first edge times one 2^e: the same sign and
+  // significand bits (a shortcut giving e; usually the x component already differs).
+  int e = 0;
+  auto scaled_edge = [&](int r) {
+    const V3<double>&a = at(r, 0), &b = at(r, 1);
+    bool known = false;
+    auto component = [&](double u, double v) {
+      if (u == 0 || v == 0) return u == v;
+      std::uint64_t x, y;
+      std::memcpy(&x, &u, sizeof x);
+      std::memcpy(&y, &v, sizeof y);
+      constexpr std::uint64_t kSignificand = 0x800FFFFFFFFFFFFFull;  // and the sign
+      const int ex = int(x >> 52 & 0x7FF), ey = int(y >> 52 & 0x7FF);
+      if (((x ^ y) & kSignificand) != 0 || ex == 0 || ey == 0 || ex == 0x7FF || ey == 0x7FF)
+        return false;
+      if (known) return ey - ex == e;
+      known = true;
+      e = ey - ex;
+      return e != 0;  // e = 0: same_edge (translates) was tried
+    };
+    return component(edge_x, b.x - a.x) && component(p1.y - p0.y, b.y - a.y) &&
+           component(p1.z - p0.z, b.z - a.z) && known;
+  };
+  auto scales = [&](int r) {
+    // The same in round-to-nearest on two_sum pairs (exact differences, see above), each
+    // pair of p's cycle scaled by 2^e, rejected where that may be inexact: a product
+    // neither normal nor an exact zero.
+    const double s = std::ldexp(1.0, e);
+    if (!std::isnormal(s)) return false;
+    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    auto same = [s](double pb, double pa, double qb, double qa) {
+      const DD u = two_sum(pb, -pa), v = two_sum(qb, -qa);
+      const double hi = u.hi * s, lo = u.lo * s;
+      return (u.hi == 0 || std::isnormal(hi)) && (u.lo == 0 || std::isnormal(lo)) && hi == v.hi &&
+             lo == v.lo;
+    };
+    const V3<double>& q0 = at(r, 0);
+    for (int k = 1; k < d; ++k) {
+      const V3<double>&a = pp[p[k]], &b = at(r, k);
+      if (!(same(a.x, p0.x, b.x, q0.x) && same(a.y, p0.y, b.y, q0.y) && same(a.z, p0.z, b.z, q0.z)))
+        return false;
+    }
+    return true;
+  };
+  for (int r = 0; r < d; ++r)
+    if (scaled_edge(r) && scales(r)) return true;
   return false;
 }
 

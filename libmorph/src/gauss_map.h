@@ -17,19 +17,20 @@ struct Location {
 };
 
 /// Whether facets f of P and g of Q (polytopes whose exact normals are Newell's of their
-/// double points) have vertex cycles that are exact translates of each other, up to where
-/// the cycles start: then their exact normals are equal (Newell's normal is invariant under
-/// both). See same_normal.
-bool translated_cycles(const Polytope& P, int f, const Polytope& Q, int g);
+/// double points) have similar vertex cycles, up to where the cycles start: exact
+/// translates, or q_k - q_0 = 2^e (p_k - p_0) for all k (a copy scaled by a power of two,
+/// e.g. 0.5 or 2: its Newell normal is 2^(2e) times p's). Then their exact normals have the
+/// same direction (Newell's normal is invariant under translation). See same_normal.
+bool similar_cycles(const Polytope& P, int f, const Polytope& Q, int g);
 
 /// Whether the exact normals of x and y are known to have the same direction, by a cheap
-/// exact test: the same facet, or translated_cycles. False when that does not show it, even
+/// exact test: the same facet, or similar_cycles. False when that does not show it, even
 /// if the directions are equal: callers then decide by the general predicates. Operands
 /// with common facet directions (A (+) A, A (+) -A of a centrally symmetric A, A (+) an exact
-/// translate) make every predicate on such normals exactly zero, and this spares the
-/// double-double and exact stages their work on them. Inline, the usual answer (far apart
-/// unit normals, or two facets of one polytope, whose directions differ: canonical form)
-/// costs a few comparisons.
+/// translate or a copy scaled by 0.5) make every predicate on such normals exactly zero, and
+/// this spares the double-double and exact stages their work on them. Inline, the usual
+/// answer (far apart unit normals, or two facets of one polytope, whose directions differ:
+/// canonical form) costs a few comparisons.
 inline bool same_normal(const NormalRef& x, const NormalRef& y) {
   if (x.polytope == y.polytope) return x.face == y.face;
   // Equal directions have unit normals within the sum of their bounds (doubled against
@@ -37,8 +38,7 @@ inline bool same_normal(const NormalRef& x, const NormalRef& y) {
   const UnitNormal &u = x.unit(), &v = y.unit();
   const double reach = 2 * (u.error + v.error);
   return std::abs(u.x - v.x) <= reach && std::abs(u.y - v.y) <= reach &&
-         std::abs(u.z - v.z) <= reach &&
-         translated_cycles(*x.polytope, x.face, *y.polytope, y.face);
+         std::abs(u.z - v.z) <= reach && similar_cycles(*x.polytope, x.face, *y.polytope, y.face);
 }
 
 /// Unit normals with the same doubles: what the unit normals of translated cycles starting
