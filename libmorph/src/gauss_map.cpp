@@ -149,12 +149,11 @@ bool similar_cycles(const Polytope& P, int f, const Polytope& Q, int g) {
     }
     return true;
   };
-  for (int r = 0; r < d; ++r)
-    if (same_edge(r) && (same_points(r) || translates(r))) return true;
   // Scaled copies: q_{r+k} - q_r = 2^e (p_k - p_0) for all k. Multiplying by 2^e is exact
   // in any rounding mode when the product is normal (or both are zero), so such edges'
   // rounded components are those of p's first edge times one 2^e: the same sign and
   // significand bits (a shortcut giving e; usually the x component already differs).
+  constexpr std::uint64_t kSignificand = 0x800FFFFFFFFFFFFFull;  // and the sign
   int e = 0;
   auto scaled_edge = [&](int r) {
     const V3<double>&a = at(r, 0), &b = at(r, 1);
@@ -164,7 +163,6 @@ bool similar_cycles(const Polytope& P, int f, const Polytope& Q, int g) {
       std::uint64_t x, y;
       std::memcpy(&x, &u, sizeof x);
       std::memcpy(&y, &v, sizeof y);
-      constexpr std::uint64_t kSignificand = 0x800FFFFFFFFFFFFFull;  // and the sign
       const int ex = int(x >> 52 & 0x7FF), ey = int(y >> 52 & 0x7FF);
       if (((x ^ y) & kSignificand) != 0 || ex == 0 || ey == 0 || ex == 0x7FF || ey == 0x7FF)
         return false;
@@ -197,8 +195,22 @@ bool similar_cycles(const Polytope& P, int f, const Polytope& Q, int g) {
     }
     return true;
   };
-  for (int r = 0; r < d; ++r)
+  // One pass over the starts, the x component of the first edge first: equal (then
+  // translates; scaled only when it is zero), or else the sign and significand bits.
+  std::uint64_t edge_bits;
+  std::memcpy(&edge_bits, &edge_x, sizeof edge_bits);
+  for (int r = 0; r < d; ++r) {
+    const double dx = at(r, 1).x - at(r, 0).x;
+    if (dx == edge_x) {
+      if (same_edge(r) && (same_points(r) || translates(r))) return true;
+      if (edge_x != 0) continue;
+    } else {
+      std::uint64_t bits;
+      std::memcpy(&bits, &dx, sizeof bits);
+      if (((bits ^ edge_bits) & kSignificand) != 0) continue;
+    }
     if (scaled_edge(r) && scales(r)) return true;
+  }
   return false;
 }
 
