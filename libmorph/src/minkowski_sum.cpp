@@ -394,6 +394,26 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
   return gather({&translated, &corner, &edge});
 }
 
+namespace {
+
+/// The distinct values among partner[b..e) (vertices of B), sorted, written to `out`; their
+/// number. `slot` is -1 at every vertex of B on entry, and 0 at those written on return
+/// (the caller numbers them there, then resets them).
+int distinct_partners(const int* partner, int b, int e, int* slot, int* out) {
+  int n = 0;
+  for (int k = b; k < e; ++k) {
+    const int j = partner[k];
+    if (slot[j] < 0) {
+      slot[j] = 0;
+      out[n++] = j;
+    }
+  }
+  std::sort(out, out + n);
+  return n;
+}
+
+}  // namespace
+
 void index_vertices(const SumFacets& facets, int num_a, int num_b,
                     std::vector<std::uint64_t>& pairs, std::vector<int>& corners) {
   const int nc = static_cast<int>(facets.corners.size());
@@ -421,15 +441,8 @@ void index_vertices(const SumFacets& facets, int num_a, int num_b,
     const auto found = std::make_unique_for_overwrite<std::uint64_t[]>(nc);
     int size = 0;
     for (int i = 0; i < num_a; ++i) {
-      int n = 0;
-      for (int k = first[i]; k < first[i + 1]; ++k) {
-        const int j = partner[k];
-        if (slot[j] < 0) {
-          slot[j] = 0;
-          partners[n++] = j;
-        }
-      }
-      std::sort(partners.get(), partners.get() + n);
+      const int n = distinct_partners(partner.get(), first[i], first[i + 1], slot.data(),
+                                      partners.get());
       for (int p = 0; p < n; ++p) {
         slot[partners[p]] = size;
         found[size++] = pair_key(i, partners[p]);
@@ -455,15 +468,7 @@ void index_vertices(const SumFacets& facets, int num_a, int num_b,
     std::vector<int>& slot = slots.local();  // all -1 between buckets
     for (int i = begin; i < end; ++i) {
       int* const own = distinct.get() + first[i];
-      int n = 0;
-      for (int k = first[i]; k < first[i + 1]; ++k) {
-        const int j = partner[k];
-        if (slot[j] < 0) {
-          slot[j] = 0;
-          own[n++] = j;
-        }
-      }
-      std::sort(own, own + n);
+      const int n = distinct_partners(partner.get(), first[i], first[i + 1], slot.data(), own);
       for (int p = 0; p < n; ++p) slot[own[p]] = p;
       for (int k = first[i]; k < first[i + 1]; ++k) partner[k] = slot[partner[k]];
       for (int p = 0; p < n; ++p) slot[own[p]] = -1;
