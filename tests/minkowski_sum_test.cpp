@@ -436,27 +436,34 @@ TEST_CASE("fims: an element away from the origin translates the sum") {
 }
 
 TEST_CASE("fims: output is identical for any thread count") {
-  const Mesh A = make_icosphere(1.0, 3);  // 1280 triangles
-  const Mesh B = transformed(make_icosphere(0.4, 2), random_rotation(31));  // 320 triangles
-  REQUIRE(A.n_faces() == 1280);
-  REQUIRE(B.n_faces() == 320);
-  const LabelledMesh one = minkowski_sum(A, B, {.threads = 1});
-  for (int threads : {2, 0}) {
-    CAPTURE(threads);
-    const LabelledMesh other = minkowski_sum(A, B, {.threads = threads});
-    CHECK(identical(one.mesh, other.mesh));
-    REQUIRE(one.origins.size() == other.origins.size());
-    bool same_origins = true;
-    for (std::size_t f = 0; f < one.origins.size(); ++f) {
-      const FacetOrigin& x = one.origins[f];
-      const FacetOrigin& y = other.origins[f];
-      same_origins = same_origins && x.kind == y.kind && x.a.kind == y.a.kind && x.a.index == y.a.index &&
-                     x.b.kind == y.b.kind && x.b.index == y.b.index;
+  const Mesh big = make_icosphere(1.0, 3);                                    // 1280 triangles
+  const Mesh small = transformed(make_icosphere(0.4, 2), random_rotation(31));  // 320 triangles
+  REQUIRE(big.n_faces() == 1280);
+  REQUIRE(small.n_faces() == 320);
+  // Both orders: with one thread the operand with fewer vertices is located first, with
+  // more both are located side by side.
+  for (const bool big_first : {true, false}) {
+    CAPTURE(big_first);
+    const Mesh& A = big_first ? big : small;
+    const Mesh& B = big_first ? small : big;
+    const LabelledMesh one = minkowski_sum(A, B, {.threads = 1});
+    for (int threads : {2, 0}) {
+      CAPTURE(threads);
+      const LabelledMesh other = minkowski_sum(A, B, {.threads = threads});
+      CHECK(identical(one.mesh, other.mesh));
+      REQUIRE(one.origins.size() == other.origins.size());
+      bool same_origins = true;
+      for (std::size_t f = 0; f < one.origins.size(); ++f) {
+        const FacetOrigin& x = one.origins[f];
+        const FacetOrigin& y = other.origins[f];
+        same_origins = same_origins && x.kind == y.kind && x.a.kind == y.a.kind &&
+                       x.a.index == y.a.index && x.b.kind == y.b.kind && x.b.index == y.b.index;
+      }
+      CHECK(same_origins);
     }
-    CHECK(same_origins);
+    CHECK(clean_mesh_problem(one.mesh, kRoundedClean).empty());
+    CHECK(origins_problem(one, A, B, true).empty());
   }
-  CHECK(clean_mesh_problem(one.mesh, kRoundedClean).empty());
-  CHECK(origins_problem(one, A, B, true).empty());
 }
 
 TEST_CASE("fims: the hull fallback gives the same output on every run and thread count") {
