@@ -327,16 +327,11 @@ struct MergedTwins {
 /// Passes 2 and 3 on a closed manifold soup: the polygons of its coplanar groups go to
 /// `out` (`changed` tells whether any merged; `out` is untouched if not). False when a
 /// group is not one disc or its polygon is not convex; `strict`: also when a needle finds
-/// no group.
+/// no group. `geo`: each facet's geometry.
 bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, const Connectivity& k,
-                    double limit, bool strict, Soup& merged, MergedTwins& merged_twins,
-                    bool& changed) {
+                    const FacetGeometry* geo, double limit, bool strict, Soup& merged,
+                    MergedTwins& merged_twins, bool& changed) {
   const int nf = soup.size();
-  const auto geo_array = std::make_unique_for_overwrite<FacetGeometry[]>(nf);
-  FacetGeometry* geo = geo_array.get();
-  parallel_chunks(nf, kFacetGrain, [&](int first, int last) {
-    for (int f = first; f < last; ++f) geo[f] = geometry(points, soup, f);
-  });
   const Groups groups = group_coplanar(points, soup, k, geo, limit);
   if (strict)
     for (int f = 0; f < nf; ++f)
@@ -550,12 +545,29 @@ std::optional<Connectivity> connect_with(int num_points, const Soup& soup, Merge
 /// `soup` is moved into the result when it is the result, and left alone otherwise.
 std::optional<std::pair<Soup, Connectivity>> simplify(const std::vector<V3<double>>& points,
                                                       Soup& soup, double limit, bool strict) {
-  std::optional<Connectivity> k = connect(static_cast<int>(points.size()), soup);
-  if (!k) return std::nullopt;
+  // The facets' geometry (for pass 2) does not depend on the connectivity: with threads to
+  // spare, computed beside `connect` (the two loops side by side, rather than each split
+  // into chunks too short to pay at a few thousand facets); else after it, if it succeeds.
+  const int nf = soup.size();
+  const auto geo = std::make_unique_for_overwrite<FacetGeometry[]>(nf);
+  const auto geometries = [&] {
+    parallel_chunks(nf, kFacetGrain, [&](int first, int last) {
+      for (int f = first; f < last; ++f) geo[f] = geometry(points, soup, f);
+    });
+  };
+  std::optional<Connectivity> k;
+  if (nf >= kFacetGrain && tbb::this_task_arena::max_concurrency() > 1) {
+    run_both(geometries, [&] { k = connect(static_cast<int>(points.size()), soup); });
+    if (!k) return std::nullopt;
+  } else {
+    k = connect(static_cast<int>(points.size()), soup);
+    if (!k) return std::nullopt;
+    geometries();
+  }
   Soup merged;
   MergedTwins merged_twins;
   bool changed = false;
-  if (!merge_coplanar(points, soup, *k, limit, strict, merged, merged_twins, changed)) {
+  if (!merge_coplanar(points, soup, *k, geo.get(), limit, strict, merged, merged_twins, changed)) {
     if (strict) return std::nullopt;
     return std::make_pair(std::move(soup), std::move(*k));
   }
