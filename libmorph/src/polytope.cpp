@@ -621,24 +621,25 @@ bool operand_topology(const Polytope& p, const HalfedgeArrays& arrays, int nf) {
     const int h = arrays.halfedge_of_vertex(v);
     if (h < 0 || h >= nh || arrays.to(h ^ 1) != v) return false;
   }
-  // A search through the fans from vertex 0, as the check's.
+  // A search through the fans from vertex 0, as the check's. Each vertex is pushed at most
+  // once: the stack needs nv slots (written before read, left uninitialised).
   std::vector<char> reached(nv, 0);
-  std::vector<int> stack;
-  stack.reserve(nv);
-  int count = 0;
+  std::unique_ptr<int[]> stack(new int[nv > 0 ? nv : 1]);
+  const int* const fan_begin = p.fan_begin.data();
+  const int* const fan_vertex = p.fan_vertex.data();
+  int top = 0, count = 0;
   if (nv > 0) {
     reached[0] = 1;
-    stack.push_back(0);
+    stack[top++] = 0;
   }
-  while (!stack.empty()) {
-    const int v = stack.back();
-    stack.pop_back();
+  while (top > 0) {
+    const int v = stack[--top];
     ++count;
-    for (int s = p.fan_begin[v]; s < p.fan_begin[v + 1]; ++s) {
-      const int w = p.fan_vertex[s];
+    for (int s = fan_begin[v], end = fan_begin[v + 1]; s < end; ++s) {
+      const int w = fan_vertex[s];
       if (reached[w]) continue;
       reached[w] = 1;
-      stack.push_back(w);
+      stack[top++] = w;
     }
   }
   return count == nv && static_cast<long long>(nv) - nh / 2 + nf == 2;
