@@ -540,3 +540,89 @@ TEST_CASE("polytope: a within_error oracle that can fail") {
   CHECK_FALSE(within_error({1, 1e-10, 0, 0.9e-10}, n));
   CHECK_FALSE(within_error({-1, 0, 0, 1.9}, n));
 }
+
+namespace {
+
+// The exact sign of det(N_left, N_right, to - from) of edge e (double points).
+int exact_edge_convexity(const Polytope& p, int e) {
+  const auto& edge = p.edges[e];
+  return CGAL::sign(det(p.exact_normal(edge.left), p.exact_normal(edge.right),
+                        morph::detail::exact_difference(p.points[edge.to], p.points[edge.from])));
+}
+
+// check_gauss_map skips the turns through three triangles once every edge is strictly convex:
+// here every such turn of `mesh`'s polytope, with its two edges, is evaluated exactly.
+void check_triangle_turns(const Mesh& mesh, const std::string& what) {
+  CAPTURE(what);
+  const Polytope p = morph::detail::make_operand(mesh, "A");
+  int turns = 0;
+  for (int v = 0; v < p.num_vertices(); ++v) {
+    const int b = p.fan_begin[v], n = p.fan_begin[v + 1] - b;
+    for (int i = 0; i < n; ++i) {
+      const int fa = p.fan_face[b + i], fb = p.fan_face[b + (i + 1) % n],
+                fc = p.fan_face[b + (i + 2) % n];
+      if (p.degree(fa) != 3 || p.degree(fb) != 3 || p.degree(fc) != 3) continue;
+      // Slot s is the edge between fan_face[s] and fan_face[s + 1].
+      CHECK(exact_edge_convexity(p, p.fan_edge[b + i]) > 0);
+      CHECK(exact_edge_convexity(p, p.fan_edge[b + (i + 1) % n]) > 0);
+      CHECK(CGAL::sign(det(p.exact_normal(fa), p.exact_normal(fb), p.exact_normal(fc))) > 0);
+      ++turns;
+    }
+  }
+  CHECK(turns > 0);
+}
+
+}  // namespace
+
+TEST_CASE("polytope: a turn through three triangles is the product of its two edges' signs") {
+  // The identity behind the skip, exactly: for triangles (v, u0, u1), (v, u1, u2), (v, u2, u3)
+  // with d_i = u_i - v, det(d0 x d1, d1 x d2, d2 x d3) = det(d0, d1, d2) det(d1, d2, d3), and
+  // the edge v-u1 (between the first two; its left facet holds v -> u1) has
+  // det(N_left, N_right, u1 - v) = -det(d0, d1, d2) |d1|^2. Points nearly degenerate, scaled
+  // by 2^+-200 and far from the origin.
+  using morph::detail::ExactN;
+  using morph::detail::V3;
+  std::uint64_t state = 12345;
+  const auto next = [&] {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<double>(state >> 11) * 0x1p-53 - 0.5;
+  };
+  int negative = 0, positive = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const double scale = trial % 4 == 0 ? 0x1p-200 : trial % 4 == 1 ? 0x1p200 : 1.0;
+    const double shift = trial % 4 == 2 ? 1e9 : 0.0;
+    const double flat = trial % 8 < 4 ? 1e-13 : 1.0;  // the u_i nearly coplanar with v
+    V3<double> q[5];
+    for (int k = 0; k < 5; ++k) {
+      const double angle = 1.2 * k + 0.3 * next();
+      q[k] = {(std::cos(angle) + shift) * scale, (std::sin(angle) + shift) * scale,
+              (k == 0 ? 0.0 : flat * next() + shift) * scale};
+    }
+    q[0] = {shift * scale, shift * scale, shift * scale};  // v
+    V3<ExactN> d[4];
+    for (int k = 0; k < 4; ++k) d[k] = morph::detail::exact_difference(q[k + 1], q[0]);
+    const V3<ExactN> na = cross(d[0], d[1]), nb = cross(d[1], d[2]), nc = cross(d[2], d[3]);
+    const ExactN turn = det(na, nb, nc);
+    CHECK(CGAL::sign(turn - det(d[0], d[1], d[2]) * det(d[1], d[2], d[3])) == CGAL::ZERO);
+    // Triangle (v, u1, u2) holds v -> u1: it is the edge's left facet, (v, u0, u1) its right.
+    CHECK(CGAL::sign(det(nb, na, d[1]) + det(d[0], d[1], d[2]) * dot(d[1], d[1])) == CGAL::ZERO);
+    (CGAL::sign(turn) < 0 ? negative : positive) += 1;
+  }
+  CHECK(negative > 0);  // the random fans turn both ways: the identity is not vacuous
+  CHECK(positive > 0);
+}
+
+TEST_CASE("polytope: every turn through three triangles of an operand is strictly convex") {
+  for (const char* name : {"icosphere_80.off", "icosphere_1280.off", "random_hull_200.off",
+                           "snub_dodecahedron.off", "uvsphere_1600.off"}) {
+    const Mesh mesh = morph::read_mesh(std::string(MORPH_SAMPLES_DIR) + "/" + name);
+    check_triangle_turns(mesh, name);
+    check_triangle_turns(morph::test::scaled(mesh, 0x1p-200), std::string(name) + " tiny");
+    check_triangle_turns(morph::test::scaled(mesh, 0x1p200), std::string(name) + " huge");
+    check_triangle_turns(morph::test::translated(mesh, Point(1e6, -3e5, 7)),
+                         std::string(name) + " far");
+  }
+  for (std::uint64_t seed = 1; seed <= 3; ++seed)
+    check_triangle_turns(morph::test::random_sphere_polytope(200, seed),
+                         "sphere " + std::to_string(seed));
+}

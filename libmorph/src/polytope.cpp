@@ -539,14 +539,26 @@ int edge_convexity(const Polytope& p, const Polytope::Edge& e) {
 }
 
 /// The Gauss map must be valid: the normals around every vertex turn strictly
-/// counter-clockwise (a convex spherical polygon).
-void check_gauss_map(const Polytope& p, const char* name) {
+/// counter-clockwise (a convex spherical polygon). `edges_convex`: every edge is known to be
+/// strictly convex and every normal is Newell's of the double points; then a turn through
+/// three triangles holds already and is not evaluated. With d_i = u_i - v for consecutive
+/// triangles (v, u0, u1), (v, u1, u2), (v, u2, u3) of v's fan, their normals are d0 x d1,
+/// d1 x d2, d2 x d3 and det(N_a, N_b, N_c) = det(d0, d1, d2) det(d1, d2, d3) exactly, where
+/// det(d0, d1, d2) is -det(N_left, N_right, to - from) / |d1|^2 for the edge v-u1 (the same
+/// for v-u2): two negative factors.
+void check_gauss_map(const Polytope& p, const char* name, bool edges_convex = false) {
   // orient_normals works in any rounding mode: no RoundingGuard.
   const UnitNormal* unit = p.unit_normals.data();
+  const int* face_begin = p.face_begin.data();
+  const auto triangle = [&](int f) { return face_begin[f + 1] - face_begin[f] == 3; };
+  // Only triangles: no turn left to evaluate, only the fan sizes.
+  const bool all_proven =
+      edges_convex && static_cast<long long>(p.corner_vertex.size()) == 3LL * p.num_faces();
   for (int v = 0; v < p.num_vertices(); ++v) {
     const int b = p.fan_begin[v], n = p.fan_begin[v + 1] - b;
     if (n < 3)
       fail(name, "vertex " + std::to_string(p.vertex_source[v]) + " has fewer than three facets");
+    if (all_proven) continue;
     const int* fan = &p.fan_face[b];
     // Triple i is (fan[i], fan[i + 1], fan[i + 2]) cyclically: each step reads one new normal.
     const UnitNormal *px = &unit[fan[0]], *py = &unit[fan[1]];
@@ -558,6 +570,9 @@ void check_gauss_map(const Polytope& p, const char* name) {
       const UnitNormal &x = *px, &y = *py, &z = *pz;
       px = py;
       py = pz;
+      if (edges_convex && triangle(fan[i]) && triangle(fan[i + 1 < n ? i + 1 : 0]) &&
+          triangle(fan[k]))
+        continue;
       const double d = x.x * (y.y * z.z - y.z * z.y) + x.y * (y.z * z.x - y.x * z.z) +
                        x.z * (y.x * z.y - y.y * z.x);
       const double bound = x.error + y.error + z.error + kUnitPredicateRounding;
@@ -606,24 +621,25 @@ bool operand_topology(const Polytope& p, const HalfedgeArrays& arrays, int nf) {
     const int h = arrays.halfedge_of_vertex(v);
     if (h < 0 || h >= nh || arrays.to(h ^ 1) != v) return false;
   }
-  // A search through the fans from vertex 0, as the check's.
+  // A search through the fans from vertex 0, as the check's. Each vertex is pushed at most
+  // once: the stack needs nv slots (written before read, left uninitialised).
   std::vector<char> reached(nv, 0);
-  std::vector<int> stack;
-  stack.reserve(nv);
-  int count = 0;
+  std::unique_ptr<int[]> stack(new int[nv > 0 ? nv : 1]);
+  const int* const fan_begin = p.fan_begin.data();
+  const int* const fan_vertex = p.fan_vertex.data();
+  int top = 0, count = 0;
   if (nv > 0) {
     reached[0] = 1;
-    stack.push_back(0);
+    stack[top++] = 0;
   }
-  while (!stack.empty()) {
-    const int v = stack.back();
-    stack.pop_back();
+  while (top > 0) {
+    const int v = stack[--top];
     ++count;
-    for (int s = p.fan_begin[v]; s < p.fan_begin[v + 1]; ++s) {
-      const int w = p.fan_vertex[s];
+    for (int s = fan_begin[v], end = fan_begin[v + 1]; s < end; ++s) {
+      const int w = fan_vertex[s];
       if (reached[w]) continue;
       reached[w] = 1;
-      stack.push_back(w);
+      stack[top++] = w;
     }
   }
   return count == nv && static_cast<long long>(nv) - nh / 2 + nf == 2;
@@ -650,19 +666,28 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   const int nf = static_cast<int>(mesh.n_faces());
   const int nh = static_cast<int>(mesh.n_halfedges());
   const bool reversed = order == FaceOrder::reversed;
-  // Corner c is halfedge corner_halfedge[c] of its face: leaving the corner's vertex when
-  // as given; when reversed, entering it (the facet runs against the halfedges). The
-  // temporaries are written before they are read: left uninitialised.
-  std::unique_ptr<int[]> corner_halfedge(new int[nh]);
-  std::vector<int> corner_of(nh, -1);
-  // What the fan walk reads of corner c, together: its facet, the previous corner of the
-  // facet, and the next corner counter-clockwise around its vertex (filled below).
-  struct FanLink {
-    int face, prev, next;
-  };
-  std::unique_ptr<FanLink[]> link(new FanLink[nh]);
+  // Corner c is a halfedge of its face: leaving the corner's vertex when as given; when
+  // reversed, entering it (the facet runs against the halfedges). What the walks know of
+  // mesh edge h / 2 (OpenMesh stores the two halfedges of edge e as 2e and 2e + 1):
+  // kUnwalked, 2 c + (h & 1) once corner c of halfedge h has met it (below kWalked: c < nh
+  // fits an int), kWalked once both have.
+  constexpr unsigned kUnwalked = ~0u, kWalked = ~0u - 1;
+  std::vector<unsigned> edge_state(nh / 2, kUnwalked);
+  // twin[c]: the corner of the other facet on c's edge. Written before it is read (as
+  // `link` below): left uninitialised.
+  std::unique_ptr<int[]> twin(new int[nh]);
   p.face_begin.resize(nf + 1);
   p.corner_vertex.resize(nh);
+  p.corner_edge.resize(nh);
+  // Each edge has two corners once every halfedge is one face's: at most nh / 2 edges,
+  // written by index in order of first use (at the smaller corner).
+  std::vector<int> mesh_edge(nh / 2);
+  p.edges.resize(nh / 2);
+  int* const corner_vertex = p.corner_vertex.data();
+  int* const corner_edge = p.corner_edge.data();
+  Polytope::Edge* const edges = p.edges.data();
+  // The last corner at each vertex, where its fan starts.
+  std::vector<int> some_corner(nv, -1);
   const HalfedgeArrays arrays(mesh);
   // The checked path's findings: whether every halfedge names the face whose cycle holds
   // it and its opposite ends at the corner's vertex (the check reads both), and `across`.
@@ -673,9 +698,13 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
     topology->across.resize(nh);
     across = topology->across.data();
   }
-  int c = 0;
+  // One walk around each face: its corners, and each edge as its first corner meets it
+  // (the edge's from, left facet and mesh edge) and completed at its second (to, right
+  // facet, and the two corners as each other's twin).
+  int c = 0, e = 0;
   for (int f = 0; f < nf; ++f) {
-    p.face_begin[f] = c;
+    const int begin = c;
+    p.face_begin[f] = begin;
     const int h0 = arrays.halfedge_of_face(f);
     // The face circulator starts at the target of h0. As given, a corner's vertex is the
     // target of the halfedge before it (read with the link to the next one).
@@ -684,64 +713,67 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
     int entering = h0;  // the halfedge that ends at the corner (as given)
     int h = start;
     do {
-      // Each halfedge once: with the count below, every halfedge is some face's.
-      if (c == nh || corner_of[h] >= 0)
+      // Each halfedge once (its edge not walked, or walked by the other halfedge only):
+      // with the count below, every halfedge is some face's.
+      unsigned& state = edge_state[h >> 1];
+      if (c == nh || state == kWalked || (state != kUnwalked && (state & 1) == (h & 1u)))
         throw error("internal error: a mesh face is not a closed cycle");
-      p.corner_vertex[c] = reversed ? arrays.to(h) : from;
-      corner_halfedge[c] = h;
-      link[c].face = f;
-      link[c].prev = c - 1;
-      corner_of[h] = c;
+      const int vertex = reversed ? arrays.to(h) : from;
+      corner_vertex[c] = vertex;
+      some_corner[vertex] = c;
+      int edge;
+      if (state == kUnwalked) {  // the edge's first corner
+        state = 2u * c + (h & 1u);
+        edge = e++;
+        edges[edge].from = vertex;
+        edges[edge].left = f;
+        mesh_edge[edge] = h >> 1;
+      } else {
+        const int t = static_cast<int>(state >> 1);
+        state = kWalked;
+        edge = corner_edge[t];
+        edges[edge].to = vertex;
+        edges[edge].right = f;
+        twin[t] = c;
+        twin[c] = t;
+      }
+      corner_edge[c] = edge;
       if (topology) {
         across[c] = arrays.face(entering ^ 1);
-        consistent = consistent && arrays.face(h) == f && arrays.to(h ^ 1) == from;
+        consistent &= (arrays.face(h) == f) & (arrays.to(h ^ 1) == from);
         entering = h;
       }
       ++c;
       if (!reversed) from = arrays.to(h);
       h = reversed ? arrays.prev(h) : arrays.next(h);
     } while (h != start);
-    link[p.face_begin[f]].prev = c - 1;
   }
   p.face_begin[nf] = c;
   if (c != nh) throw error("internal error: a mesh halfedge has no face");
+  // Every halfedge has been walked once, so each edge's two corners have both been met: e is
+  // nh / 2, and every corner has its twin.
   const int nc = c;
-  // The corner of the other facet on c's edge (its halfedge is the opposite one; OpenMesh
-  // stores the two halfedges of edge e as 2e and 2e + 1). Its vertex is the other end of
-  // c's edge, in either order.
-  auto twin = [&](int k) { return corner_of[corner_halfedge[k] ^ 1]; };
-  // One pass over the corners: edges in order of first use (an edge is first used by the
-  // smaller of its two corners), the fan links (from the last corner at v, the next facet
-  // counter-clockwise is across the incoming edge u -> v, at corner twin(prev corner),
-  // precomputed so that the fan walk below follows one link per step, as
-  // build_connectivity walks them) and the last corner at each vertex, where its fan starts.
-  // Each edge has two corners (every halfedge is one face's): nc / 2 edges, written by index.
-  const int ne = nc / 2;
-  std::vector<int> mesh_edge(ne);
-  p.edges.resize(ne);
-  p.corner_edge.resize(nc);
-  std::vector<int> some_corner(nv, -1);
-  int e = 0;
+  // What the fan walk reads at corner c, together, so that each step is one load: its facet,
+  // the previous corner's vertex and edge (the slot from c's vertex to it), and the next
+  // corner counter-clockwise around c's vertex: from facet f at v, the next facet is the
+  // one across f's incoming edge u -> v, at the twin of the previous corner (as
+  // build_connectivity walks them).
+  struct FanLink {
+    int face, prev_vertex, prev_edge, next;
+  };
+  std::unique_ptr<FanLink[]> link(new FanLink[nc]);
   for (int f = 0; f < nf; ++f) {
     const int begin = p.face_begin[f], end = p.face_begin[f + 1];
-    for (c = begin; c < end; ++c) {
-      const int t = twin(c);
-      // c is the previous corner of the facet's next one, whose fan link is twin(c).
-      link[c + 1 == end ? begin : c + 1].next = t;
-      some_corner[p.corner_vertex[c]] = c;
-      if (t < c) continue;  // numbered at t
-      if (e == ne) throw error("internal error: a mesh edge has one face");
-      p.edges[e] = {p.corner_vertex[c], p.corner_vertex[t], f, link[t].face};
-      mesh_edge[e] = corner_halfedge[c] >> 1;
-      p.corner_edge[c] = e;
-      p.corner_edge[t] = e;
-      ++e;
-    }
+    for (int k = begin, prev = end - 1; k < end; prev = k++)
+      link[k] = {f, corner_vertex[prev], corner_edge[prev], twin[prev]};
   }
   p.fan_begin.resize(nv + 1);
   p.fan_face.resize(nc);
   p.fan_edge.resize(nc);
   p.fan_vertex.resize(nc);
+  int* const fan_face = p.fan_face.data();
+  int* const fan_edge = p.fan_edge.data();
+  int* const fan_vertex = p.fan_vertex.data();
   int slot = 0;
   // The checked path: the vertex whose fan last reached each vertex (a neighbour reached
   // twice means two edges between the same vertices).
@@ -757,12 +789,12 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
     do {
       if (slot == nc) throw error("internal error: a mesh vertex has a broken fan");
       const FanLink& l = link[c];
-      p.fan_face[slot] = l.face;
-      p.fan_edge[slot] = p.corner_edge[l.prev];
-      const int w = p.corner_vertex[l.prev];
-      p.fan_vertex[slot] = w;
+      fan_face[slot] = l.face;
+      fan_edge[slot] = l.prev_edge;
+      const int w = l.prev_vertex;
+      fan_vertex[slot] = w;
       if (topology) {
-        consistent = consistent && seen[w] != v;
+        consistent &= seen[w] != v;
         seen[w] = v;
       }
       ++slot;
@@ -1006,8 +1038,9 @@ Polytope finish_from_halfedges(Polytope& p, std::vector<int> mesh_edge, const Me
   p.face_source.resize(p.num_faces());
   std::iota(p.face_source.begin(), p.face_source.end(), 0);
   p.edge_source = std::move(mesh_edge);
-  // Every edge is strictly convex (is_canonical); the Gauss map is left to check.
-  check_gauss_map(p, name);
+  // Every edge is strictly convex (is_canonical); the Gauss map is left to check, where
+  // that does not already prove it (turns through three triangles).
+  check_gauss_map(p, name, true);
   return std::move(p);
 }
 
@@ -1021,6 +1054,19 @@ void copy_points(Polytope& p, const Mesh& mesh) {
   for (int v = 0; v < p.num_vertices(); ++v) p.points[v] = {q[v][0], q[v][1], q[v][2]};
 }
 
+/// copy_points, and whether the mesh is readable() (every coordinate finite), in one pass.
+bool copy_readable_points(Polytope& p, const Mesh& mesh) {
+  p.points.resize(mesh.n_vertices());
+  const Point* q = mesh.points();
+  bool finite = true;
+  for (int v = 0; v < p.num_vertices(); ++v) {
+    const V3<double> x{q[v][0], q[v][1], q[v][2]};
+    finite &= std::isfinite(x.x) & std::isfinite(x.y) & std::isfinite(x.z);
+    p.points[v] = x;
+  }
+  return finite;
+}
+
 /// make_operand(mesh, name) in one pass for a mesh that is an operand as it is (the usual
 /// case): the halfedge walks that build the polytope also find whether check_operand's
 /// topological checks pass, and its geometric checks then run on the polytope's facet cycles
@@ -1029,14 +1075,14 @@ void copy_points(Polytope& p, const Mesh& mesh) {
 /// walks meet anything unusual: make_operand then checks and builds as before, for the same
 /// messages. The polytope is make_polytope(mesh, name)'s, built by the same code.
 std::optional<Polytope> checked_polytope(const Mesh& mesh, const char* name) {
-  if (mesh.n_faces() == 0 || has_deleted_elements(mesh) || !readable(mesh)) return std::nullopt;
+  if (mesh.n_faces() == 0 || has_deleted_elements(mesh)) return std::nullopt;
   if (mesh.has_halfedge_status()) {  // the check counts only live halfedges
     const auto& status = mesh.property(mesh.halfedge_status_pph()).data_vector();
     if (std::any_of(status.begin(), status.end(), [](const auto& s) { return s.deleted(); }))
       return std::nullopt;
   }
   Polytope p;
-  copy_points(p, mesh);
+  if (!copy_readable_points(p, mesh)) return std::nullopt;
   OperandTopology topology;
   std::vector<int> mesh_edge;
   try {

@@ -389,7 +389,10 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, double 
   const int b = cycles.begin[f];
   const int* ids = cycles.vertex + b;
   const int i0 = ids[0], i1 = ids[1], i2 = ids[2];
-  if (i0 == i1 || i0 == i2 || i1 == i2) return false;
+  // A repeated vertex or position needs no test of its own here: with two equal corners,
+  // two of the cross products below are opposites and the third is zero (a x a), so the
+  // normal is exactly zero (in round-to-nearest; within a few ulps of D^2 in any rounding
+  // mode, far below kZeroAreaRatio D^2) and the zero-area test rejects the triangle.
   const Point &p0 = m.points[i0], &p1 = m.points[i1], &p2 = m.points[i2];
   // In plain doubles, straight-line: OpenMesh's vector operations, one component at a time.
   const double cx = (((0.0 + p0[0]) + p1[0]) + p2[0]) * (1.0 / 3);
@@ -404,7 +407,6 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, double 
   double nx = ((0.0 + (ay * bz - az * by)) + (by * qz - bz * qy)) + (qy * az - qz * ay);
   double ny = ((0.0 + (az * bx - ax * bz)) + (bz * qx - bx * qz)) + (qz * ax - qx * az);
   double nz = ((0.0 + (ax * by - ay * bx)) + (bx * qy - by * qx)) + (qx * ay - qy * ax);
-  if (p0 == p1 || p0 == p2 || p1 == p2) return false;
   const double length = std::sqrt((nx * nx + ny * ny) + nz * nz);
   if (!(length > zero_area)) return false;
   const double inverse = 1.0 / length;
@@ -461,9 +463,10 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, double 
 // Fills `geometry` for the later checks when the mesh passes; planarity is judged with
 // `relative_tolerance` times the bounding-box diagonal. With `convexity` (only for a closed
 // mesh), also whether any edge may be reflex, with each face's plane while it is at hand.
+// `finite`: the caller has found every coordinate finite (the first test is skipped).
 Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& geometry,
-                      bool convexity = false) {
-  for (int v = 0; v < m.n_vertices; ++v) {
+                      bool convexity = false, bool finite = false) {
+  for (int v = 0; v < m.n_vertices && !finite; ++v) {
     if (!m.live_vertex(v)) continue;
     const Point& p = m.points[v];
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
@@ -669,7 +672,8 @@ bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles, double plana
   geometry.cycles.begin = cycles.begin;
   geometry.cycles.vertex = cycles.vertex;
   geometry.cycles.across = cycles.across;
-  if (nondegenerate(m, planarity_tolerance, geometry, true).verdict != Verdict::ok) return false;
+  if (nondegenerate(m, planarity_tolerance, geometry, true, true).verdict != Verdict::ok)
+    return false;
   if (outward(geometry.volumes).verdict != Verdict::ok) return false;
   // A reflex flag means planar_and_convex() finds a reflex edge (the same test on the same
   // face, edge and vertex): no need to look for it.

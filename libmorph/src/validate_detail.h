@@ -69,11 +69,11 @@ struct FaceCycleView {
 };
 
 /// Whether check_operand(mesh) (with this tolerance) returns nothing: the mesh is an operand
-/// as it is. Only for a mesh without deleted elements that the caller has found to pass
-/// check_operand's topological checks (closed, every vertex one fan reaching each neighbour
-/// once, connected, Euler characteristic 2), with its face cycles: runs the geometric checks
-/// alone, on the same values with the same verdicts. False when check_operand would throw
-/// or flip the mesh (its caller then calls it, for the message). Linear in the mesh.
+/// as it is. Only for a mesh without deleted elements, with every coordinate finite, that the
+/// caller has found to pass check_operand's topological checks (closed, every vertex one fan
+/// reaching each neighbour once, connected, Euler characteristic 2), with its face cycles: runs the
+/// geometric checks alone, on the same values with the same verdicts. False when check_operand
+/// would throw or flip the mesh (its caller then calls it, for the message). Linear in the mesh.
 bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles,
                      double planarity_tolerance = kPlanarityTolerance);
 
