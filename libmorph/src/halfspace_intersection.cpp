@@ -371,8 +371,41 @@ void precise_meet(const PrecisePlane& a, const PrecisePlane& b, const PrecisePla
 /// ones (W in [1, 2)), another's as the meet of its precise planes (`crosses`: their
 /// normals' cross products bc, ca, ab when the caller has them, as in precise_meet). Left
 /// out when a plane is not valid or a value out of range.
-template <class PrecisePlanesT>
-void make_precise(const PrecisePlanesT& planes, HVertex& v,
+/// The planes' precise copies, each made when a filter first needs it, by whichever thread
+/// needs it first (the copy does not depend on the thread, so neither does any decision).
+/// Shared by every stage of an intersection: the flips, each check, the incremental hull.
+class PrecisePlanes {
+ public:
+  explicit PrecisePlanes(const std::vector<Plane>& planes)
+      : planes_(planes),
+        precise_(planes.size()),
+        state_(std::make_unique<std::atomic<unsigned char>[]>(planes.size())) {}
+  const PrecisePlane& operator[](int i) const {  // any rounding mode
+    if (state_[i].load(std::memory_order_acquire) != kMade) make(i);
+    return precise_[i];
+  }
+
+ private:
+  // Each plane's state: not made, being made (by the thread that claimed it), made. A flag
+  // of our own: std::call_once costs more than most of the copies it guards.
+  static constexpr unsigned char kNone = 0, kMaking = 1, kMade = 2;
+  [[gnu::noinline]] void make(int i) const {  // (keeps operator[] small enough to inline)
+    unsigned char expected = kNone;
+    if (state_[i].compare_exchange_strong(expected, kMaking, std::memory_order_acquire)) {
+      CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+      precise_[i] = precise_plane(planes_[i]);
+      state_[i].store(kMade, std::memory_order_release);
+      return;
+    }
+    while (state_[i].load(std::memory_order_acquire) != kMade) std::this_thread::yield();
+  }
+
+  const std::vector<Plane>& planes_;
+  mutable std::vector<PrecisePlane> precise_;  // each written once, by its claiming thread
+  std::unique_ptr<std::atomic<unsigned char>[]> state_;
+};
+
+void make_precise(const PrecisePlanes& planes, HVertex& v,
                   const std::array<V3<DD>, 3>* crosses = nullptr) {
   v.precise_tried = true;
   if (v.known >= 0) {
@@ -434,40 +467,6 @@ int precise_compare(const PrecisePlane& p, const HVertex& u, const HVertex& v) {
   if (value.hi < -bound) return -1;
   return 2;
 }
-
-/// The planes' precise copies, each made when a filter first needs it, by whichever thread
-/// needs it first (the copy does not depend on the thread, so neither does any decision).
-/// Shared by every stage of an intersection: the flips, each check, the incremental hull.
-class PrecisePlanes {
- public:
-  explicit PrecisePlanes(const std::vector<Plane>& planes)
-      : planes_(planes),
-        precise_(planes.size()),
-        state_(std::make_unique<std::atomic<unsigned char>[]>(planes.size())) {}
-  const PrecisePlane& operator[](int i) const {  // any rounding mode
-    if (state_[i].load(std::memory_order_acquire) != kMade) make(i);
-    return precise_[i];
-  }
-
- private:
-  // Each plane's state: not made, being made (by the thread that claimed it), made. A flag
-  // of our own: std::call_once costs more than most of the copies it guards.
-  static constexpr unsigned char kNone = 0, kMaking = 1, kMade = 2;
-  void make(int i) const {
-    unsigned char expected = kNone;
-    if (state_[i].compare_exchange_strong(expected, kMaking, std::memory_order_acquire)) {
-      CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
-      precise_[i] = precise_plane(planes_[i]);
-      state_[i].store(kMade, std::memory_order_release);
-      return;
-    }
-    while (state_[i].load(std::memory_order_acquire) != kMade) std::this_thread::yield();
-  }
-
-  const std::vector<Plane>& planes_;
-  mutable std::vector<PrecisePlane> precise_;  // each written once, by its claiming thread
-  std::unique_ptr<std::atomic<unsigned char>[]> state_;
-};
 
 /// Sign of <n, x> - d at a vertex from the filters alone (intervals, then the precise
 /// stage in round-to-nearest), or 2: > 0 when the vertex violates the half-space. A known
@@ -1602,8 +1601,7 @@ void probe_rounding(const HVertex& v, PreciseProbe& out) {
 PreciseProbe probe_precise(const std::vector<HalfSpace>& hs) {
   const std::vector<Plane> planes = planes_of(hs);
   CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
-  std::vector<PrecisePlane> precise;
-  for (const Plane& p : planes) precise.push_back(precise_plane(p));
+  const PrecisePlanes precise(planes);
   PreciseProbe out;
   HVertex u;
   u.planes = {0, 1, 2};
@@ -1627,7 +1625,8 @@ PreciseProbe probe_precise_point(const V3<ExactN>& X, const ExactN& W) {
   v.X = X;
   v.W = W;
   v.has_exact = true;
-  make_precise(std::vector<PrecisePlane>{}, v);
+  const std::vector<Plane> none;
+  make_precise(PrecisePlanes(none), v);
   probe_rounding(v, out);
   return out;
 }
