@@ -524,6 +524,64 @@ TEST_CASE("halfspace_intersection: an erosion by a small element is guessed from
   }
 }
 
+// An erosion's half-spaces of quadrilaterals (a UV sphere's, not exactly planar; a cube's,
+// whose parallel facets tie B's vertices) against exact evaluation: the normal is A's exact
+// Newell normal, the offset max_k <n, p_k> - max_j <n, b_j> over A's corners and all of B's
+// vertices, and every known point of the facet lies exactly on its plane. Scaled by 2^+-200
+// and shifted far from the origin; each erosion then equal by the three routes.
+TEST_CASE("halfspace_intersection: an erosion's quadrilateral half-spaces are exact") {
+  const morph::Mesh& uv = sample("uvsphere_1600.off");
+  const morph::Mesh snub = morph::test::scaled(sample("snub_dodecahedron.off"), 0.25);
+  struct Case {
+    const char* what;
+    morph::Mesh A, B;
+  };
+  const Case cases[] = {
+      {"uvsphere by a snub dodecahedron", uv, snub},
+      {"uvsphere by a cube", uv, morph::test::cube(0.25)},
+      {"uvsphere scaled by 2^200", morph::test::scaled(uv, 0x1p200),
+       morph::test::scaled(snub, 0x1p200)},
+      {"uvsphere scaled by 2^-200", morph::test::scaled(uv, 0x1p-200),
+       morph::test::scaled(snub, 0x1p-200)},
+      {"uvsphere far from the origin", morph::test::translated(uv, {1e6, -3e5, 7e5}), snub},
+      {"cube by a cube", morph::test::cube(2), morph::test::cube(0.5)},
+      {"rotated cube by a rotated cube", morph::test::rotated_cube_quads(2, 5),
+       morph::test::rotated_cube_quads(0.5, 9)},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(std::string(c.what));
+    const Polytope A = make_operand(c.A, "A"), B = make_operand(c.B, "B");
+    const ErosionInput in = erode_sum_input(A, A, B);
+    REQUIRE(static_cast<int>(in.halfspaces.size()) == A.num_faces());
+    int quads = 0;
+    for (int f = 0; f < A.num_faces(); ++f) {
+      if (A.degree(f) != 4) continue;
+      ++quads;
+      const HalfSpace& h = in.halfspaces[f];
+      const V3<ExactN>& n = A.exact_normal(f);
+      CHECK((h.normal.x == n.x && h.normal.y == n.y && h.normal.z == n.z));
+      std::optional<ExactN> top_a, top_b;
+      for (int k = 0; k < 4; ++k) {
+        const ExactN d = dot(n, to_exact_n(A.points[A.corner(f, k)]));
+        if (!top_a || d > *top_a) top_a = d;
+      }
+      for (const auto& b : B.points) {
+        const ExactN d = dot(n, to_exact_n(b));
+        if (!top_b || d > *top_b) top_b = d;
+      }
+      CHECK(h.denominator == ExactN(1));
+      CHECK(h.offset == *top_a - *top_b);
+      for (int j = in.known.begin[f]; j < in.known.begin[f + 1]; ++j) {
+        const int k = in.known.point[j];
+        CHECK(dot(n, in.known.X[k]) == h.offset * in.known.W[k]);
+      }
+    }
+    CHECK(quads > 0);
+    const MaybePolytope r = eroded_three_ways(A, B);
+    REQUIRE(r.polytope);
+  }
+}
+
 // The element of the random erosion and opening tests: an integer polytope (parallel
 // facets) every third seed, else a random polytope of 11 to 22 vertices.
 namespace {

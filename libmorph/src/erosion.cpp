@@ -218,6 +218,29 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
             others[f].push_back(c);
         continue;
       }
+      if (A.degree(f) == 4 && A.given_normals.empty() && A.exact_points.empty() &&
+          B.exact_points.empty()) {
+        // A quadrilateral of double points (often not exactly planar: a UV sphere's): its
+        // Newell normal, sum of p_k x p_k+1, is exactly the cross product of its diagonals
+        // (p2 - p0) x (p3 - p1), A.exact_normal(f)'s value in two differences and one cross
+        // product. h_A is attained at the corners p_k with the largest <n, p_k - p0> (exact
+        // dots of double differences, as the triangle's), and h_A - h_B = <n, p_best - b>.
+        const auto corner = [&](int k) -> const V3<double>& { return A.points[A.corner(f, k)]; };
+        h.normal = cross(exact_difference(corner(2), corner(0)),
+                         exact_difference(corner(3), corner(1)));
+        std::array<ExactN, 4> height{ExactN(0), ExactN(0), ExactN(0), ExactN(0)};
+        int top = 0;
+        for (int k = 1; k < 4; ++k) {
+          height[k] = dot(h.normal, exact_difference(corner(k), corner(0)));
+          if (height[k] > height[top]) top = k;
+        }
+        for (int k = 0; k < 4; ++k) on[k] = k == top || height[k] == height[top];
+        h.offset = dot(h.normal, exact_difference(corner(top), B.points[b]));
+        for (int c : candidates)
+          if (c != b && CGAL::sign(dot(h.normal, exact_difference(B.points[c], B.points[b]))) == 0)
+            others[f].push_back(c);
+        continue;
+      }
       const V3<ExactN> n =
           A.degree(f) == 3 && A.given_normals.empty() ? triangle_normal(A, f) : A.exact_normal(f);
       // h_A(N_f) = max over f's corners of <n, X> / W, compared by cross-multiplication

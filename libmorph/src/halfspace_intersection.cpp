@@ -40,6 +40,7 @@
 #include <memory>
 #include <mutex>
 #include <numeric>
+#include <thread>
 
 #include "fims.h"
 #include "gauss_map.h"
@@ -157,6 +158,7 @@ struct HVertex {
   V3<double> ex{};
   double ew = 0;
   bool precise = false;
+  bool precise_tried = false;  // make_precise was called (it may have left it out)
   bool doubles = false;  // a known point X / 1 with X exactly doubles: its rounding is X
 };
 
@@ -369,8 +371,43 @@ void precise_meet(const PrecisePlane& a, const PrecisePlane& b, const PrecisePla
 /// ones (W in [1, 2)), another's as the meet of its precise planes (`crosses`: their
 /// normals' cross products bc, ca, ab when the caller has them, as in precise_meet). Left
 /// out when a plane is not valid or a value out of range.
-void make_precise(const std::vector<PrecisePlane>& planes, HVertex& v,
+/// The planes' precise copies, each made when a filter first needs it, by whichever thread
+/// needs it first (the copy does not depend on the thread, so neither does any decision).
+/// Shared by every stage of an intersection: the flips, each check, the incremental hull.
+class PrecisePlanes {
+ public:
+  explicit PrecisePlanes(const std::vector<Plane>& planes)
+      : planes_(planes),
+        precise_(planes.size()),
+        state_(std::make_unique<std::atomic<unsigned char>[]>(planes.size())) {}
+  const PrecisePlane& operator[](int i) const {  // any rounding mode
+    if (state_[i].load(std::memory_order_acquire) != kMade) make(i);
+    return precise_[i];
+  }
+
+ private:
+  // Each plane's state: not made, being made (by the thread that claimed it), made. A flag
+  // of our own: std::call_once costs more than most of the copies it guards.
+  static constexpr unsigned char kNone = 0, kMaking = 1, kMade = 2;
+  [[gnu::noinline]] void make(int i) const {  // (keeps operator[] small enough to inline)
+    unsigned char expected = kNone;
+    if (state_[i].compare_exchange_strong(expected, kMaking, std::memory_order_acquire)) {
+      CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+      precise_[i] = precise_plane(planes_[i]);
+      state_[i].store(kMade, std::memory_order_release);
+      return;
+    }
+    while (state_[i].load(std::memory_order_acquire) != kMade) std::this_thread::yield();
+  }
+
+  const std::vector<Plane>& planes_;
+  mutable std::vector<PrecisePlane> precise_;  // each written once, by its claiming thread
+  std::unique_ptr<std::atomic<unsigned char>[]> state_;
+};
+
+void make_precise(const PrecisePlanes& planes, HVertex& v,
                   const std::array<V3<DD>, 3>* crosses = nullptr) {
+  v.precise_tried = true;
   if (v.known >= 0) {
     const auto is_double = [](const ExactN& x) {
       const double d = x.to_double();
@@ -431,52 +468,49 @@ int precise_compare(const PrecisePlane& p, const HVertex& u, const HVertex& v) {
   return 2;
 }
 
-/// A plane's precise copy, made when a filter first needs it (by the one thread that
-/// tests that plane).
-class LazyPrecisePlane {
- public:
-  explicit LazyPrecisePlane(const Plane& plane) : plane_(plane) {}
-  const PrecisePlane& get() {  // round-to-nearest
-    if (!made_) precise_ = precise_plane(plane_);
-    made_ = true;
-    return precise_;
-  }
-
- private:
-  const Plane& plane_;
-  PrecisePlane precise_;
-  bool made_ = false;
-};
-
 /// Sign of <n, x> - d at a vertex from the filters alone (intervals, then the precise
 /// stage in round-to-nearest), or 2: > 0 when the vertex violates the half-space. A known
 /// point skips the precise stage: its exact coordinates are there, and small (in a closing
 /// the undecided tests are mostly exact zeros, planes touching the result).
-int side_filter(const Plane& p, LazyPrecisePlane& precise, const HVertex& v) {
+int side_filter(const Plane& p, const PrecisePlanes& precise, int i, const HVertex& v) {
   const int s = interval_sign(dot(p.ni, v.Xi) - p.di * v.Wi);
   if (s != 2 || !v.precise || v.known >= 0) return s;
   CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
-  const PrecisePlane& q = precise.get();
+  const PrecisePlane& q = precise[i];
   return q.valid ? precise_side(q, v) : 2;
 }
 int side_exact(const Plane& p, const HVertex& v) { return CGAL::sign(dot(p.n, v.X) - p.d * v.W); }
 
-/// Sign of <n, x> - d at a vertex, its exact coordinates computed when the filter fails
-/// (the vertices are not precise yet where this is used).
-int side(const std::vector<Plane>& planes, const Plane& p, HVertex& v) {
+/// Sign of <n, x> - d for plane i at a vertex: intervals, then the precise stage (the
+/// vertex made precise when first needed there; a known point skips it, as in
+/// side_filter), then exact coordinates (computed once). Planes nearly through one point
+/// (the moved facets around a vertex of a nearly planar A) leave most of these tests to
+/// the precise stage.
+int side(const std::vector<Plane>& planes, const PrecisePlanes& precise, int i, HVertex& v) {
+  const Plane& p = planes[i];
   const int s = interval_sign(dot(p.ni, v.Xi) - p.di * v.Wi);
   if (s != 2) return s;
+  if (v.known < 0) {
+    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    if (!v.precise_tried) make_precise(precise, v);
+    const PrecisePlane& q = precise[i];
+    if (v.precise && q.valid) {
+      const int t = precise_side(q, v);
+      if (t != 2) return t;
+    }
+  }
   make_exact(planes, v);
   return side_exact(p, v);
 }
 
 /// Sign of <n, u> - <n, v> from the filters alone, or 2 (two known points skip the
 /// precise stage, as in side_filter).
-int compare_filter(const Plane& p, LazyPrecisePlane& precise, const HVertex& u, const HVertex& v) {
+int compare_filter(const Plane& p, const PrecisePlanes& precise, int i, const HVertex& u,
+                   const HVertex& v) {
   const int s = interval_sign(dot(p.ni, u.xi) - dot(p.ni, v.xi));
   if (s != 2 || !u.precise || !v.precise || (u.known >= 0 && v.known >= 0)) return s;
   CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
-  const PrecisePlane& q = precise.get();
+  const PrecisePlane& q = precise[i];
   return q.valid ? precise_compare(q, u, v) : 2;
 }
 int compare_exact(const Plane& p, const HVertex& u, const HVertex& v) {
@@ -807,6 +841,7 @@ Polytope verified_polytope(std::vector<V3<double>> points, ExactPoints exact,
 /// options.eager_exact, else on demand: polytope_points).
 std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
                                             const std::vector<Plane>& planes,
+                                            const PrecisePlanes& precise,
                                             const KnownPoints& known, DualSurface s,
                                             const IntersectOptions& options) {
   const bool with_polytope = options.polytope;
@@ -894,7 +929,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
           if (cn[j] != a && cn[j] != b) far = cn[j];
         const int sd = far < 0                        ? 1
                        : known_through(known, far, v) ? 0
-                                                      : side(planes, planes[far], v);
+                                                      : side(planes, precise, far, v);
         if (sd > 0) ok = false;
         far_side[3 * t + k] = static_cast<signed char>(sd);
       }
@@ -995,15 +1030,14 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   // see polytope_points).
   // The planes of vertices that are not known points are made precise up front; the
   // others when the walk below first needs them.
-  std::vector<PrecisePlane> precise(n);
   {
     std::vector<char> used(n, 0);
     for (const HVertex& v : vertex)
-      if (v.known < 0) used[v.planes[0]] = used[v.planes[1]] = used[v.planes[2]] = 1;
+      if (v.known < 0 && !v.precise)
+        used[v.planes[0]] = used[v.planes[1]] = used[v.planes[2]] = 1;
     parallel_chunks(n, 256, [&](int begin, int end) {
-      CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
       for (int i = begin; i < end; ++i)
-        if (used[i]) precise[i] = precise_plane(planes[i]);
+        if (used[i]) precise[i];
     });
   }
   // The cross products of precise normals along the edges of the triangles that give the
@@ -1012,7 +1046,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   std::vector<char> from_planes(nt, 0);
   for (int v = 0; v < nv; ++v) {
     const HVertex& x = vertex[v];
-    from_planes[seed[v]] = x.known < 0 && x.planes == s.corner[seed[v]] &&
+    from_planes[seed[v]] = x.known < 0 && !x.precise && x.planes == s.corner[seed[v]] &&
                            precise[x.planes[0]].valid && precise[x.planes[1]].valid &&
                            precise[x.planes[2]].valid;
   }
@@ -1037,7 +1071,8 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     for (int v = begin; v < end; ++v) {
       const int t = seed[v];
       if (!from_planes[t]) {
-        make_precise(precise, vertex[v]);
+        // (A vertex made precise by the flips or the checks above keeps it.)
+        if (!vertex[v].precise) make_precise(precise, vertex[v]);
       } else {
         // Edge k runs from corner k to corner k + 1: ab, bc, ca for k = 0, 1, 2.
         std::array<V3<DD>, 3> along;
@@ -1061,8 +1096,9 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     }
   });
   LazyExact exact_vertex(planes, vertex);
-  const auto side_of = [&](const Plane& p, LazyPrecisePlane& q, int v) {
-    const int s = side_filter(p, q, vertex[v]);
+  const auto side_of = [&](int i, int v) {
+    const Plane& p = planes[i];
+    const int s = side_filter(p, precise, i, vertex[v]);
     return s != 2 ? s : side_exact(p, exact_vertex(v));
   };
   // The candidate is a convex polytope. Every plane that is not a dual vertex must not cut
@@ -1088,8 +1124,8 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     std::vector<int> plateau;  // scratch: each list is then allocated once, at its size
     std::vector<signed char> sides;
     for (int j = begin; j < end && ok; ++j) {
-      const Plane& p = planes[others[j]];
-      LazyPrecisePlane precise_p(p);
+      const int i = others[j];
+      const Plane& p = planes[i];
       if (!known.empty())
         for (int k = known.begin[others[j]]; k < known.begin[others[j] + 1]; ++k)
           if (vertex_at_point[known.point[k]] >= 0) {
@@ -1106,10 +1142,10 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
         for (int a = adj_begin[u]; a < adj_begin[u + 1]; ++a) {
           int s;
           if (u_on) {
-            s = known_through(known, others[j], vertex[adj[a]]) ? 0 : side_of(p, precise_p, adj[a]);
+            s = known_through(known, others[j], vertex[adj[a]]) ? 0 : side_of(i, adj[a]);
             sides.push_back(static_cast<signed char>(s));
           } else {
-            s = compare_filter(p, precise_p, vertex[adj[a]], vertex[u]);
+            s = compare_filter(p, precise, i, vertex[adj[a]], vertex[u]);
             if (s == 2) s = compare_exact(p, exact_vertex(adj[a]), exact_vertex(u));
           }
           if (s > 0) {
@@ -1119,7 +1155,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
           }
         }
       }
-      const int sd = u_on ? 0 : side_of(p, precise_p, u);
+      const int sd = u_on ? 0 : side_of(i, u);
       if (sd > 0) ok = false;
       if (sd != 0) continue;
       plateau.assign(1, u);
@@ -1128,7 +1164,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
           if (std::find(plateau.begin(), plateau.end(), adj[a]) == plateau.end() &&
               (q == 0 && u_on ? sides[a - adj_begin[u]] == 0
                               : known_through(known, others[j], vertex[adj[a]]) ||
-                                    side_of(p, precise_p, adj[a]) == 0))
+                                    side_of(i, adj[a]) == 0))
             plateau.push_back(adj[a]);
       std::sort(plateau.begin(), plateau.end());
       touched[j].assign(plateau.begin(), plateau.end());
@@ -1285,9 +1321,9 @@ class IncrementalHull {
  public:
   enum class Outcome { hull, too_small, failed };
 
-  IncrementalHull(const std::vector<Plane>& planes, const KnownPoints& known, const V3<double>& o,
-                  double reach)
-      : planes_(planes), known_(known), n_(static_cast<int>(planes.size())) {
+  IncrementalHull(const std::vector<Plane>& planes, const PrecisePlanes& precise,
+                  const KnownPoints& known, const V3<double>& o, double reach)
+      : planes_(planes), precise_(precise), known_(known), n_(static_cast<int>(planes.size())) {
     const double dirs[4][3] = {{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}};
     for (int k = 0; k < 4; ++k) {
       const V3<ExactN> m{ExactN(dirs[k][0]), ExactN(dirs[k][1]), ExactN(dirs[k][2])};
@@ -1330,6 +1366,7 @@ class IncrementalHull {
     V3<Interval> Xi;               // the vertex of the three planes, X / W
     Interval Wi;
     int exact = -1;    // its exact coordinates in exact_, once computed
+    int precise = -1;  // its precise coordinates in precise_vertex_, once tried (-2: none)
     int known = -1;    // the known point it is, if any (KnownPoints)
     int pending = -1;  // first of the planes that see it (linked by next_pending_)
     bool alive = true;
@@ -1365,6 +1402,27 @@ class IncrementalHull {
     }
     const int s = interval_sign(dot(h.ni, tri.Xi) - h.di * tri.Wi);
     if (s != 2) return s;
+    // The precise stage, for real planes (nearly through one point: the moved facets around
+    // a vertex of a nearly planar A).
+    if (p < n_ && tri.precise != -2 && std::max({tri.c[0], tri.c[1], tri.c[2]}) < n_) {
+      CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+      if (tri.precise < 0) {
+        HVertex v;
+        v.planes = tri.c;
+        make_precise(precise_, v);
+        if (v.precise) {
+          precise_vertex_.push_back(std::move(v));
+          tri.precise = static_cast<int>(precise_vertex_.size()) - 1;
+        } else {
+          tri.precise = -2;
+        }
+      }
+      const PrecisePlane& q = precise_[p];
+      if (tri.precise >= 0 && q.valid) {
+        const int t = precise_side(q, precise_vertex_[tri.precise]);
+        if (t != 2) return t;
+      }
+    }
     if (tri.exact < 0) {
       const Plane &a = plane(tri.c[0]), &b = plane(tri.c[1]), &c = plane(tri.c[2]);
       ExactVertex& v = exact_.emplace_back();
@@ -1473,11 +1531,13 @@ class IncrementalHull {
   }
 
   const std::vector<Plane>& planes_;
+  const PrecisePlanes& precise_;
   const KnownPoints& known_;
   int n_;
   std::array<Plane, 4> virtual_;
   std::vector<Tri> tris_;
   std::deque<ExactVertex> exact_;
+  std::deque<HVertex> precise_vertex_;
   std::vector<int> conflict_, next_pending_;  // per real plane
   std::vector<int> start_at_;                 // per plane: new triangle starting there
   std::vector<int> visible_, created_;
@@ -1541,8 +1601,7 @@ void probe_rounding(const HVertex& v, PreciseProbe& out) {
 PreciseProbe probe_precise(const std::vector<HalfSpace>& hs) {
   const std::vector<Plane> planes = planes_of(hs);
   CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
-  std::vector<PrecisePlane> precise;
-  for (const Plane& p : planes) precise.push_back(precise_plane(p));
+  const PrecisePlanes precise(planes);
   PreciseProbe out;
   HVertex u;
   u.planes = {0, 1, 2};
@@ -1566,7 +1625,8 @@ PreciseProbe probe_precise_point(const V3<ExactN>& X, const ExactN& W) {
   v.X = X;
   v.W = W;
   v.has_exact = true;
-  make_precise({}, v);
+  const std::vector<Plane> none;
+  make_precise(PrecisePlanes(none), v);
   probe_rounding(v, out);
   return out;
 }
@@ -1614,8 +1674,8 @@ constexpr int kFlipsPerCorner = 4;
 /// When it splits the polygon, each final triangle's vertex is in out_vertex (out_has set;
 /// it is the flips' scratch space on the way).
 /// Needs a RoundingGuard.
-bool triangulate_polygon(const std::vector<Plane>& planes, const KnownPoints& known, const int* p,
-                         int k, bool split, std::array<int, 3>* out, HVertex* out_vertex,
+bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& precise,
+                         const KnownPoints& known, const int* p, int k, bool split, std::array<int, 3>* out, HVertex* out_vertex,
                          char* out_has, PolygonScratch& scratch) {
   // Planes through one known point (facets of A moved by one vertex of B): one vertex.
   if (k == 3 || common_point(known, p, k) >= 0) {
@@ -1657,6 +1717,7 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const KnownPoints& kn
     HVertex& v = vertex[t];  // fresh, or a flipped triangle's: drop what that one had
     v.has_exact = false;
     v.known = -1;
+    v.precise = v.precise_tried = false;
     v.planes = {p[i], p[j], p[l]};
     const Plane &a = planes[p[i]], &b = planes[p[j]], &c = planes[p[l]];
     meet_of_crosses(a.ni, a.di, b.di, c.di, cross_of(j, l), cross_of(l, i), cross_of(i, j), v.Xi,
@@ -1680,7 +1741,7 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const KnownPoints& kn
     return -1;
   };
   const auto side_of = [&](int plane, HVertex& v) {
-    return known_through(known, p[plane], v) ? 0 : side(planes, planes[p[plane]], v);
+    return known_through(known, p[plane], v) ? 0 : side(planes, precise, p[plane], v);
   };
   const auto diagonal = [&](int a, int c) { return (c - a + k) % k != 1 && (a - c + k) % k != 1; };
   for (int flips = 0; !pending.empty();) {
@@ -1713,8 +1774,8 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const KnownPoints& kn
 /// triangulated (triangulate_polygon, in parallel; counter-clockwise seen from outside, as
 /// the dual hull's), joined across shared edges. Empty when a polygon cannot be
 /// triangulated or the triangles do not close up into a surface.
-DualSurface expected_surface(const std::vector<Plane>& planes, const KnownPoints& known,
-                             const ExpectedVertices& expected) {
+DualSurface expected_surface(const std::vector<Plane>& planes, const PrecisePlanes& precise,
+                             const KnownPoints& known, const ExpectedVertices& expected) {
   DualSurface s;
   const int nv = static_cast<int>(expected.begin.size()) - 1;
   std::vector<int> first(nv + 1, 0);  // each polygon's first triangle
@@ -1734,7 +1795,7 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const KnownPoints
     RoundingGuard guard;
     PolygonScratch scratch;
     for (int v = begin; v < end && ok; ++v)
-      if (!triangulate_polygon(planes, known, &expected.facets[expected.begin[v]],
+      if (!triangulate_polygon(planes, precise, known, &expected.facets[expected.begin[v]],
                                expected.begin[v + 1] - expected.begin[v], expected.split,
                                &s.corner[first[v]], expected.split ? &s.vertex[first[v]] : nullptr,
                                expected.split ? &s.has_vertex[first[v]] : nullptr, scratch))
@@ -1803,9 +1864,10 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
   }
   // The verification does not depend on o: any exact interior point (there is one) makes
   // the duality argument hold, so the rounded o only has to centre the virtual planes.
+  const PrecisePlanes precise(planes);
   if (options.incremental && options.guess && !expected.empty()) {
-    if (auto built =
-            build_verified(hs, planes, known, expected_surface(planes, known, expected), options)) {
+    if (auto built = build_verified(hs, planes, precise, known,
+                                    expected_surface(planes, precise, known, expected), options)) {
       built->route = HullRoute::expected;
       return std::move(*built);
     }
@@ -1814,10 +1876,10 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
     double reach = first_reach(planes, o_double);
     for (int attempt = 0; attempt < kReachAttempts; ++attempt, reach = std::ldexp(reach, 20)) {
       DualSurface s;
-      const auto outcome = IncrementalHull(planes, known, o_double, reach).run(s);
+      const auto outcome = IncrementalHull(planes, precise, known, o_double, reach).run(s);
       if (outcome == IncrementalHull::Outcome::too_small) continue;
       if (outcome == IncrementalHull::Outcome::hull) {
-        if (auto built = build_verified(hs, planes, known, std::move(s), options)) {
+        if (auto built = build_verified(hs, planes, precise, known, std::move(s), options)) {
           built->route = HullRoute::incremental;
           return std::move(*built);
         }
@@ -1825,7 +1887,7 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
       break;
     }
   }
-  auto built = build_verified(hs, planes, known, exact_dual_hull(planes, o), options);
+  auto built = build_verified(hs, planes, precise, known, exact_dual_hull(planes, o), options);
   if (!built) throw error("internal error: the exact dual hull of an erosion failed its own check");
   built->route = HullRoute::exact;
   return std::move(*built);
