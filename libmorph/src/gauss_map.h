@@ -121,7 +121,17 @@ inline int orient_arc(const Polytope& P, int e, const ArcPlane& plane, const Nor
 Location locate(const Polytope& P, const ArcPlane* slots, const NormalRef& p, int hint);
 
 /// A vertex of the feature `loc` (the contributing vertex when it is a vertex region).
-int location_vertex(const Polytope& P, const Location& loc);
+inline int location_vertex(const Polytope& P, const Location& loc) {
+  switch (loc.kind) {
+    case Location::Kind::vertex:
+      return loc.index;
+    case Location::Kind::edge:
+      return P.edges[loc.index].from;
+    case Location::Kind::face:
+      return P.corner(loc.index, 0);
+  }
+  return 0;
+}
 
 /// Locates every facet normal of `from` in the Gauss map of `in`, in parallel, each walk
 /// starting from the previous facet's answer (facets near in index order are usually
