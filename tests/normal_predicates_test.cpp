@@ -347,11 +347,11 @@ TEST_CASE("normal predicates: same_normal and the kernel's orientations on coinc
   }
 }
 
-// The double-double stage alone (orient_normals_precise) must return the exact sign or
-// kUndecided, never a wrong sign: on triples of a facet of A, its nearest facets of B and
-// their neighbours (a nearly parallel pair with a far third normal, decided from the pair's
-// precise normals only, and mirror-symmetric triples, whose shared zero component is shown
-// from the points), in every argument order, also scaled by 2^+-200, moved far from the
+// The double-double stage alone (orient_normals_precise, and cross_dot_normals_precise) must
+// return the exact sign or kUndecided, never a wrong sign: on triples of a facet of A, its nearest
+// facets of B and their neighbours (a nearly parallel pair with a far third normal, decided from
+// the pair's precise normals only, and mirror-symmetric triples, whose shared zero component is
+// shown from the points), in every argument order, also scaled by 2^+-200, moved far from the
 // origin, and for a copy turned by 1e-12 (every pair nearly parallel). The precise normals'
 // zero components must be exactly those of the exact normals.
 TEST_CASE("normal predicates: the double-double stage alone agrees with exact evaluation") {
@@ -388,6 +388,7 @@ TEST_CASE("normal predicates: the double-double stage alone agrees with exact ev
           CHECK(n.exactly_zero(i) == (CGAL::sign(i == 0 ? x.x : i == 1 ? x.y : x.z) == 0));
       }
     int tested = 0, decided = 0, zero = 0, zero_decided = 0, tiny = 0, tiny_decided = 0;
+    int tested_cross = 0, decided_cross = 0;
     std::vector<int> order(B.num_faces());
     for (int f = 0; f < A.num_faces(); ++f) {
       const NormalRef a{&A, f};
@@ -418,6 +419,18 @@ TEST_CASE("normal predicates: the double-double stage alone agrees with exact ev
               ++tested;
               decided += s != morph::detail::kUndecided;
             }
+            // (x x y) . (z x t) in the forms between() evaluates on such triples, and with
+            // the nearly parallel pair second.
+            for (const auto& [x, y, z, t] :
+                 {std::tuple{p, q, p, r}, std::tuple{q, r, p, r}, std::tuple{p, r, q, r},
+                  std::tuple{r, p, q, p}, std::tuple{q, p, r, q}, std::tuple{p, q, r, p}}) {
+              const int exact_cross =
+                  CGAL::sign(morph::detail::cross_dot(x.exact(), y.exact(), z.exact(), t.exact()));
+              const int s = morph::detail::cross_dot_normals_precise(x, y, z, t);
+              if (s != morph::detail::kUndecided) CHECK(s == exact_cross);
+              ++tested_cross;
+              decided_cross += s != morph::detail::kUndecided;
+            }
             zero += exact == 0;
             zero_decided += exact == 0 && all;
             tiny += below;
@@ -426,8 +439,10 @@ TEST_CASE("normal predicates: the double-double stage alone agrees with exact ev
     }
     MESSAGE(pair.what << ": " << tested << " orientations, " << decided << " decided; " << zero
                       << " exactly coplanar triples (" << zero_decided << " decided), " << tiny
-                      << " nonzero below the double filter (" << tiny_decided << " decided)");
+                      << " nonzero below the double filter (" << tiny_decided << " decided); "
+                      << tested_cross << " of cross_dot, " << decided_cross << " decided");
     CHECK(decided > 0);
+    CHECK(decided_cross > 0);
     if (pair.degenerate) {
       CHECK(zero_decided > 0);
       CHECK(tiny_decided > 0);

@@ -298,28 +298,23 @@ bool component_surely_zero(const Polytope& P, int f, int i) {
   return projection_degenerate(P.points[c[0]], P.points[c[1]], P.points[c[2]], i);
 }
 
-/// Sign of z . (N_x x N_y) for a nearly parallel pair x, y (or kUndecided): the cross product
-/// in double-double from x's and y's precise normals, dotted in doubles with z's unit normal.
-/// The far normal z needs no precise normal: det(x, y, z) of two nearly parallel normals is
-/// small because N_x x N_y is, and only that product needs the extra precision. Round-to-
-/// nearest (the caller's guard). With X, Y the precise normals (sigma_x N_x + E_x, sigma_y N_y
-/// + E_y, sigma > 0) and W the computed X x Y, w its high parts:
+/// N_x x N_y for a nearly parallel pair x, y, times a positive factor, as doubles w with a
+/// bound eps on their (Euclidean) distance to it: the cross product in double-double of x's and
+/// y's precise normals. False when a precise normal is not valid. Round-to-nearest (the
+/// caller's guard). With X, Y the precise normals (sigma_x N_x + E_x, sigma_y N_y + E_y,
+/// sigma > 0), W the computed X x Y and w its high parts:
 ///  - |W - X x Y| <= 32 u^2 (|X_j Y_l| + |X_l Y_j|) per component (precise_newell's triangle
 ///    bound: two products and a difference of double-doubles, doubled), with 1.01 for the
 ///    rounding of the magnitudes and 2^-1000 for underflow;
 ///  - |X x Y - sigma_x sigma_y N_x x N_y| <= |E_x| |Y| + |X*| |E_y| (length and error bounds);
 ///  - |w - W| <= sum |lo|;
-/// so |w - W*| <= eps (W* = sigma_x sigma_y N_x x N_y) summing the three. For the unit normal
-/// z^ within e_z of z = N_z / |N_z| (|z| = 1), the double dot D = z^ . w satisfies
-/// |D - z . W*| <= |D - z^ . w| + e_z |w| + eps, with |D - z^ . w| <= 3 ulps (any rounding) of
-/// sum |z^_i w_i| and |w| <= sum |w_i|: the bound below, with margins. z . W* has the sign of
-/// det(N_x, N_y, N_z) (positive factors sigma_x sigma_y |N_z|).
-int orient_near_pair(const NormalRef& x, const NormalRef& y, const UnitNormal& z) {
+/// eps sums the three (per-component bounds summed bound the Euclidean distance).
+bool precise_cross(const NormalRef& x, const NormalRef& y, double w[3], double& eps) {
   const PreciseNormal& X = x.polytope->precise_normal(x.face);
   const PreciseNormal& Y = y.polytope->precise_normal(y.face);
-  if (!X.valid || !Y.valid || !std::isfinite(z.error)) return kUndecided;
+  if (!X.valid || !Y.valid) return false;
   auto dd = [](const PreciseNormal& n, int i) { return DD{n.hi[i], n.lo[i]}; };
-  double w[3], eps = 0;
+  eps = 0;
   for (int i = 0; i < 3; ++i) {
     const int j = (i + 1) % 3, l = (i + 2) % 3;
     const DD c = dd(X, j) * dd(Y, l) - dd(X, l) * dd(Y, j);
@@ -329,10 +324,49 @@ int orient_near_pair(const NormalRef& x, const NormalRef& y, const UnitNormal& z
     eps += 32 * kU2 * magnitude * 1.01 + 0x1p-1000 + std::abs(c.lo);
   }
   eps += error_bound(X) * length_bound(Y) + length_bound(X) * error_bound(Y);
+  return true;
+}
+
+/// Sign of z . (N_x x N_y) for a nearly parallel pair x, y (or kUndecided): precise_cross,
+/// dotted in doubles with z's unit normal. The far normal z needs no precise normal:
+/// det(x, y, z) of two nearly parallel normals is small because N_x x N_y is, and only that
+/// product needs the extra precision. For w within eps of W* (a positive multiple of
+/// N_x x N_y) and the unit normal z^ within e_z of z = N_z / |N_z| (|z| = 1), the double dot
+/// D = z^ . w satisfies |D - z . W*| <= |D - z^ . w| + e_z |w| + eps, with |D - z^ . w| <= 3
+/// ulps (any rounding) of sum |z^_i w_i| and |w| <= sum |w_i|: the bound below, with margins.
+/// z . W* has the sign of det(N_x, N_y, N_z).
+int orient_near_pair(const NormalRef& x, const NormalRef& y, const UnitNormal& z) {
+  double w[3], eps;
+  if (!std::isfinite(z.error) || !precise_cross(x, y, w, eps)) return kUndecided;
   const double d = z.x * w[0] + z.y * w[1] + z.z * w[2];
   const double size = std::abs(w[0]) + std::abs(w[1]) + std::abs(w[2]);
   const double products = std::abs(z.x * w[0]) + std::abs(z.y * w[1]) + std::abs(z.z * w[2]);
   const double bound = (z.error * size + eps + 4 * 0x1p-52 * products) * 1.01 + 0x1p-1000;
+  if (d > bound) return 1;
+  if (d < -bound) return -1;
+  return kUndecided;
+}
+
+/// Sign of (N_x x N_y) . (N_z x N_t) for a nearly parallel pair x, y (or kUndecided):
+/// precise_cross (w within eps of W*, a positive multiple of N_x x N_y), dotted in doubles with
+/// v = z^ x t^ from the unit normals. For the unit vectors z, t of N_z, N_t: |z^ x t^ - z x t|
+/// <= e_z |t^| + |z| e_t <= 1.01 e_z + e_t, and rounding v's components adds at most 2e-14
+/// (kUnitPredicateRounding's bound on such unit evaluations): |v - z x t| <= ev. Then the
+/// double dot D = w . v satisfies |D - W* . (z x t)| <= |D - w . v| + eps |v| + |W*| ev, with
+/// |D - w . v| <= 3 ulps of sum |w_i v_i|, |v| <= sum |v_i| and |W*| <= sum |w_i| + eps.
+int cross_dot_near_pair(const NormalRef& x, const NormalRef& y, const UnitNormal& z,
+                        const UnitNormal& t) {
+  double w[3], eps;
+  if (!std::isfinite(z.error) || !std::isfinite(t.error) || !precise_cross(x, y, w, eps))
+    return kUndecided;
+  const double v[3] = {z.y * t.z - z.z * t.y, z.z * t.x - z.x * t.z, z.x * t.y - z.y * t.x};
+  const double ev = 1.01 * z.error + t.error + kUnitPredicateRounding;
+  const double d = w[0] * v[0] + w[1] * v[1] + w[2] * v[2];
+  const double size_w = std::abs(w[0]) + std::abs(w[1]) + std::abs(w[2]);
+  const double size_v = std::abs(v[0]) + std::abs(v[1]) + std::abs(v[2]);
+  const double products = std::abs(w[0] * v[0]) + std::abs(w[1] * v[1]) + std::abs(w[2] * v[2]);
+  const double bound =
+      (eps * size_v + (size_w + eps) * ev + 4 * 0x1p-52 * products) * 1.01 + 0x1p-1000;
   if (d > bound) return 1;
   if (d < -bound) return -1;
   return kUndecided;
@@ -424,6 +458,17 @@ int cross_dot_normals_precise(const NormalRef& a, const NormalRef& b, const Norm
     // As orient_normals_undecided: double-double on precise normals (nearly parallel
     // normals give values far below what doubles resolve), in round-to-nearest.
     CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    // First as orient_normals_precise, from the nearly parallel pair's precise normals only
+    // (a x b or c x d, whichever pair's unit normals have the larger |dot|; the value is
+    // symmetric in the two cross products).
+    {
+      const UnitNormal &ua = a.unit(), &ub = b.unit(), &uc = c.unit(), &ud = d.unit();
+      const double ab = std::abs(ua.x * ub.x + ua.y * ub.y + ua.z * ub.z);
+      const double cd = std::abs(uc.x * ud.x + uc.y * ud.y + uc.z * ud.z);
+      const int s =
+          ab >= cd ? cross_dot_near_pair(a, b, uc, ud) : cross_dot_near_pair(c, d, ua, ub);
+      if (s != kUndecided) return s;
+    }
     const PreciseNormal& p = a.polytope->precise_normal(a.face);
     const PreciseNormal& q = b.polytope->precise_normal(b.face);
     const PreciseNormal& r = c.polytope->precise_normal(c.face);
