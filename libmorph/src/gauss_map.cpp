@@ -256,13 +256,13 @@ std::vector<ArcPlane> slot_planes(const Polytope& P) {
   return slots;
 }
 
-Location locate(const Polytope& P, const ArcPlane* slots, const NormalRef& p, int hint) {
+Location locate(const Polytope& P, const ArcPlane* slots, const NormalRef& p, int hint, bool step) {
   // First one cheap step in doubles: to the neighbour of the hint with the largest support
   // value <p, x>, if it beats the hint's. It only picks where the exact walk starts, which
   // then usually finds the region at once (climbing on to the top in doubles costs a scan
   // of the top's neighbours, more than the region test it would spare).
   int v = hint;
-  {
+  if (step) {
     const UnitNormal& d = p.unit();
     auto support = [&](int w) {
       return d.x * P.points[w].x + d.y * P.points[w].y + d.z * P.points[w].z;
@@ -304,8 +304,9 @@ std::vector<Location> locate_all(const Polytope& from, const Polytope& in,
   parallel_chunks(from.num_faces(), 256, [&](int begin, int end) {
     int hint = 0;
     for (int f = begin; f < end; ++f) {
-      if (hints && (*hints)[f] >= 0) hint = (*hints)[f];
-      loc[f] = locate(in, in_slots, NormalRef{&from, f}, hint);
+      const bool hinted = hints && (*hints)[f] >= 0;
+      if (hinted) hint = (*hints)[f];
+      loc[f] = locate(in, in_slots, NormalRef{&from, f}, hint, !hinted);
       hint = location_vertex(in, loc[f]);
     }
   });
