@@ -346,3 +346,106 @@ TEST_CASE("normal predicates: same_normal and the kernel's orientations on coinc
     if (pair.coincident) CHECK(shown > 0);
   }
 }
+
+// The double-double stage alone (orient_normals_precise, and cross_dot_normals_precise) must
+// return the exact sign or kUndecided, never a wrong sign: on triples of a facet of A, its nearest
+// facets of B and their neighbours (a nearly parallel pair with a far third normal, decided from
+// the pair's precise normals only, and mirror-symmetric triples, whose shared zero component is
+// shown from the points), in every argument order, also scaled by 2^+-200, moved far from the
+// origin, and for a copy turned by 1e-12 (every pair nearly parallel). The precise normals'
+// zero components must be exactly those of the exact normals.
+TEST_CASE("normal predicates: the double-double stage alone agrees with exact evaluation") {
+  namespace test = morph::test;
+  const Mesh ico320 = sample("icosphere_320.off"), ico1280 = sample("icosphere_1280.off");
+  const std::vector<double> up = {0x1p200, 0, 0, 0, 0x1p200, 0, 0, 0, 0x1p200};
+  const std::vector<double> down = {0x1p-200, 0, 0, 0, 0x1p-200, 0, 0, 0, 0x1p-200};
+  struct Pair {
+    std::string what;
+    Mesh a, b;
+    bool degenerate;  // known to hold nearly parallel pairs and exactly coplanar triples
+  };
+  const std::vector<Pair> pairs = {
+      {"icosphere 320 and 1280", ico320, ico1280, true},
+      {"icosphere 320 and 1280 scaled by 2^-200 and 2^200", test::transformed(ico320, down),
+       test::transformed(ico1280, up), true},
+      {"icosphere 320 and 1280 far from the origin", shifted(ico320, 1024), shifted(ico1280, -4096),
+       false},
+      {"icosphere 1280 and a copy turned by 1e-12", ico1280,
+       test::transformed(ico1280, small_rotation(1e-12)), false},
+      {"integer polytopes", test::random_integer_polytope(60, 3, 4),
+       test::random_integer_polytope(60, 4, 4), false},
+  };
+  for (const auto& pair : pairs) {
+    CAPTURE(pair.what);
+    const Polytope A = morph::detail::make_operand(pair.a, "A");
+    const Polytope B = morph::detail::make_operand(pair.b, "B");
+    for (const Polytope* P : {&A, &B})
+      for (int f = 0; f < P->num_faces(); ++f) {
+        const auto& n = P->precise_normal(f);
+        if (!n.valid) continue;
+        const auto& x = P->exact_normal(f);
+        for (int i = 0; i < 3; ++i)
+          CHECK(n.exactly_zero(i) == (CGAL::sign(i == 0 ? x.x : i == 1 ? x.y : x.z) == 0));
+      }
+    int tested = 0, decided = 0, zero = 0, zero_decided = 0, tiny = 0, tiny_decided = 0;
+    int tested_cross = 0, decided_cross = 0;
+    std::vector<int> order(B.num_faces());
+    for (int f = 0; f < A.num_faces(); ++f) {
+      const NormalRef a{&A, f};
+      closest_three(B, a.unit(), order);
+      std::vector<NormalRef> near = {a};
+      for (int k = 0; k < 3; ++k) near.push_back({&B, order[k]});
+      for (const auto& [P, g] : {std::pair{&A, f}, std::pair{&B, order[0]}})
+        for (int i = P->face_begin[g]; i < P->face_begin[g + 1]; ++i) {
+          const auto& e = P->edges[P->corner_edge[i]];
+          near.push_back({P, e.left == g ? e.right : e.left});
+        }
+      for (std::size_t i = 0; i < near.size(); ++i)
+        for (std::size_t j = i + 1; j < near.size(); ++j)
+          for (std::size_t k = j + 1; k < near.size(); ++k) {
+            const NormalRef &p = near[i], &q = near[j], &r = near[k];
+            const int exact = CGAL::sign(morph::detail::det(p.exact(), q.exact(), r.exact()));
+            const auto &u = p.unit(), &v = q.unit(), &w = r.unit();
+            const double filter = u.x * (v.y * w.z - v.z * w.y) + u.y * (v.z * w.x - v.x * w.z) +
+                                  u.z * (v.x * w.y - v.y * w.x);
+            const bool below = exact != 0 && std::abs(filter) < 1e-13;
+            bool all = true;
+            for (const auto& [x, y, z, sign] :
+                 {std::tuple{p, q, r, 1}, std::tuple{q, r, p, 1}, std::tuple{r, p, q, 1},
+                  std::tuple{q, p, r, -1}, std::tuple{p, r, q, -1}, std::tuple{r, q, p, -1}}) {
+              const int s = morph::detail::orient_normals_precise(x, y, z);
+              if (s != morph::detail::kUndecided) CHECK(s == sign * exact);
+              all = all && s != morph::detail::kUndecided;
+              ++tested;
+              decided += s != morph::detail::kUndecided;
+            }
+            // (x x y) . (z x t) in the forms between() evaluates on such triples, and with
+            // the nearly parallel pair second.
+            for (const auto& [x, y, z, t] :
+                 {std::tuple{p, q, p, r}, std::tuple{q, r, p, r}, std::tuple{p, r, q, r},
+                  std::tuple{r, p, q, p}, std::tuple{q, p, r, q}, std::tuple{p, q, r, p}}) {
+              const int exact_cross =
+                  CGAL::sign(morph::detail::cross_dot(x.exact(), y.exact(), z.exact(), t.exact()));
+              const int s = morph::detail::cross_dot_normals_precise(x, y, z, t);
+              if (s != morph::detail::kUndecided) CHECK(s == exact_cross);
+              ++tested_cross;
+              decided_cross += s != morph::detail::kUndecided;
+            }
+            zero += exact == 0;
+            zero_decided += exact == 0 && all;
+            tiny += below;
+            tiny_decided += below && all;
+          }
+    }
+    MESSAGE(pair.what << ": " << tested << " orientations, " << decided << " decided; " << zero
+                      << " exactly coplanar triples (" << zero_decided << " decided), " << tiny
+                      << " nonzero below the double filter (" << tiny_decided << " decided); "
+                      << tested_cross << " of cross_dot, " << decided_cross << " decided");
+    CHECK(decided > 0);
+    CHECK(decided_cross > 0);
+    if (pair.degenerate) {
+      CHECK(zero_decided > 0);
+      CHECK(tiny_decided > 0);
+    }
+  }
+}

@@ -33,20 +33,37 @@ bool between(const NormalRef& p, const NormalRef& x, const NormalRef& q) {
          (s2 != kUndecided || cross_dot_normals_exact(x, q, p, q) >= 0);
 }
 
+/// region_test's exact part, for a region whose slots the double filter left undecided (none
+/// certainly negative): decides each. Out of line, so that the usual test stays small.
+[[gnu::noinline]] int decide_slots(const Polytope& P, const ArcPlane* slots, int v,
+                                   const NormalRef& p, int zeros[2], int& nzeros) {
+  const int b = P.fan_begin[v], n = P.fan_begin[v + 1] - b;
+  const int* const fan = P.fan_face.data() + b;
+  for (int i = 0; i < n; ++i) {
+    const NormalRef l{&P, fan[i]}, r{&P, fan[i + 1 == n ? 0 : i + 1]};
+    int s = orient_arc_filter(slots ? slots[b + i] : cross_plane(l.unit(), r.unit()), p);
+    if (s == kUndecided)
+      // p at a facet normal of this map (A (+) A) is the usual reason for an undecided slot.
+      s = orient_undecided(l, r, p, true);
+    if (s < 0) return i;
+    if (s == 0) {
+      if (nzeros == 2) throw error("internal error: a direction lies on three arcs of one region");
+      zeros[nzeros++] = i;
+    }
+  }
+  return -1;
+}
+
 /// Signs of det(N_fan[i], N_fan[i+1], p) for the slots of v's region (`slots`: P's
 /// slot_planes, or null to form them here). Returns a slot whose sign is negative (the one
 /// the double filter finds most negative, when it finds one: the walk heads toward p), or
 /// -1 when p is in the closed region, with `zeros` then holding the slots whose arc
 /// contains p.
-int region_test(const Polytope& P, const ArcPlane* slots, int v, const NormalRef& p, int zeros[2],
-                int& nzeros) {
+inline int region_test(const Polytope& P, const ArcPlane* slots, int v, const NormalRef& p,
+                       int zeros[2], int& nzeros) {
   const int b = P.fan_begin[v], n = P.fan_begin[v + 1] - b;
   const int* const fan = P.fan_face.data() + b;
   nzeros = 0;
-  auto formed = [&](int i) {
-    return cross_plane(P.unit_normals[fan[i]], P.unit_normals[fan[i + 1 == n ? 0 : i + 1]]);
-  };
-  auto plane = [&](int i) { return slots ? slots[b + i] : formed(i); };
   // The double stage of orient_arc on every slot at once.
   const UnitNormal& u = p.unit();
   bool inside = true;
@@ -65,23 +82,12 @@ int region_test(const Polytope& P, const ArcPlane* slots, int v, const NormalRef
   if (slots)
     scan([&](int i) { return slots[b + i]; });
   else
-    scan(formed);
+    scan([&](int i) {
+      return cross_plane(P.unit_normals[fan[i]], P.unit_normals[fan[i + 1 == n ? 0 : i + 1]]);
+    });
   if (inside) return -1;
   if (most >= 0) return most;
-  // Undecided slots, none certainly negative: decide each.
-  for (int i = 0; i < n; ++i) {
-    int s = orient_arc_filter(plane(i), p);
-    if (s == kUndecided)
-      // p at a facet normal of this map (A (+) A) is the usual reason for an undecided slot.
-      s = orient_undecided(NormalRef{&P, fan[i]}, NormalRef{&P, fan[i + 1 == n ? 0 : i + 1]}, p,
-                           true);
-    if (s < 0) return i;
-    if (s == 0) {
-      if (nzeros == 2) throw error("internal error: a direction lies on three arcs of one region");
-      zeros[nzeros++] = i;
-    }
-  }
-  return -1;
+  return decide_slots(P, slots, v, p, zeros, nzeros);
 }
 
 Location classify(const Polytope& P, int v, const int zeros[2], int nzeros) {
@@ -250,13 +256,13 @@ std::vector<ArcPlane> slot_planes(const Polytope& P) {
   return slots;
 }
 
-Location locate(const Polytope& P, const ArcPlane* slots, const NormalRef& p, int hint) {
+Location locate(const Polytope& P, const ArcPlane* slots, const NormalRef& p, int hint, bool step) {
   // First one cheap step in doubles: to the neighbour of the hint with the largest support
   // value <p, x>, if it beats the hint's. It only picks where the exact walk starts, which
   // then usually finds the region at once (climbing on to the top in doubles costs a scan
   // of the top's neighbours, more than the region test it would spare).
   int v = hint;
-  {
+  if (step) {
     const UnitNormal& d = p.unit();
     auto support = [&](int w) {
       return d.x * P.points[w].x + d.y * P.points[w].y + d.z * P.points[w].z;
@@ -286,18 +292,6 @@ Location locate(const Polytope& P, const ArcPlane* slots, const NormalRef& p, in
   throw error("internal error: a direction lies in no region of the Gauss map");
 }
 
-int location_vertex(const Polytope& P, const Location& loc) {
-  switch (loc.kind) {
-    case Location::Kind::vertex:
-      return loc.index;
-    case Location::Kind::edge:
-      return P.edges[loc.index].from;
-    case Location::Kind::face:
-      return P.corner(loc.index, 0);
-  }
-  return 0;
-}
-
 std::vector<Location> locate_all(const Polytope& from, const Polytope& in,
                                  const std::vector<int>* hints) {
   // A walk tests about ten slots, and forming a slot's plane costs about as much as testing
@@ -310,8 +304,9 @@ std::vector<Location> locate_all(const Polytope& from, const Polytope& in,
   parallel_chunks(from.num_faces(), 256, [&](int begin, int end) {
     int hint = 0;
     for (int f = begin; f < end; ++f) {
-      if (hints && (*hints)[f] >= 0) hint = (*hints)[f];
-      loc[f] = locate(in, in_slots, NormalRef{&from, f}, hint);
+      const bool hinted = hints && (*hints)[f] >= 0;
+      if (hinted) hint = (*hints)[f];
+      loc[f] = locate(in, in_slots, NormalRef{&from, f}, hint, !hinted);
       hint = location_vertex(in, loc[f]);
     }
   });

@@ -115,18 +115,29 @@ inline int orient_arc(const Polytope& P, int e, const ArcPlane& plane, const Nor
 /// slot's plane as it is tested, cheaper for a few directions): the vertex whose region
 /// contains it in its interior (the contributing vertex), the edge whose arc contains it, or the
 /// facet whose normal has its direction. The walk starts at vertex `hint`, takes one step up
-/// the support function in doubles (only to choose where to start), then walks exactly from
-/// region to region; the answer is exact and does not depend on the hint. Expected
-/// O(distance walked).
-Location locate(const Polytope& P, const ArcPlane* slots, const NormalRef& p, int hint);
+/// the support function in doubles (only to choose where to start; not when `step` is false,
+/// for a hint already chosen by support), then walks exactly from region to region; the answer
+/// is exact and does not depend on the hint. Expected O(distance walked).
+Location locate(const Polytope& P, const ArcPlane* slots, const NormalRef& p, int hint,
+                bool step = true);
 
 /// A vertex of the feature `loc` (the contributing vertex when it is a vertex region).
-int location_vertex(const Polytope& P, const Location& loc);
+inline int location_vertex(const Polytope& P, const Location& loc) {
+  switch (loc.kind) {
+    case Location::Kind::vertex:
+      return loc.index;
+    case Location::Kind::edge:
+      return P.edges[loc.index].from;
+    case Location::Kind::face:
+      return P.corner(loc.index, 0);
+  }
+  return 0;
+}
 
 /// Locates every facet normal of `from` in the Gauss map of `in`, in parallel, each walk
 /// starting from the previous facet's answer (facets near in index order are usually
-/// near on the sphere), or where `hints` says (a vertex of `in` per facet of `from`; -1:
-/// where the previous facet's ended).
+/// near on the sphere), or where `hints` says (a vertex of `in` per facet of `from`, chosen
+/// by support: the walk then takes no step first; -1: where the previous facet's ended).
 std::vector<Location> locate_all(const Polytope& from, const Polytope& in,
                                  const std::vector<int>* hints = nullptr);
 

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <initializer_list>
 #include <memory>
+#include <limits>
 #include <numeric>
 
 #include "fims.h"
@@ -272,9 +273,10 @@ bool facets_adjacent(const Polytope& P, int f, int g) {
 /// Where to start locating each facet f of X in Y's Gauss map, from Y's facets located in
 /// X's (loc_y): N_f is the common corner of the regions of f's corners in X's map, so the
 /// facets of Y whose normals those regions contain are the ones near it; the walk starts
-/// at a corner of the nearest of them in the first such region that has any (nearest in
-/// doubles: it only picks where the exact walk starts; one region's scan costs less than
-/// the steps the others would spare). -1 when those regions contain none.
+/// at the corner furthest along N_f of the nearest of them in the first such region that has
+/// any (nearest and furthest in doubles: they only pick where the exact walk starts; one
+/// region's scan costs less than the steps the others would spare). -1 when those regions
+/// contain none.
 std::vector<int> walk_starts(const Polytope& X, const Polytope& Y,
                              const std::vector<Location>& loc_y) {
   // Y's facets by the vertex of X whose region contains their normal (a counting sort).
@@ -302,7 +304,19 @@ std::vector<int> walk_starts(const Polytope& X, const Polytope& Y,
           }
         }
       }
-      if (nearest >= 0) starts[f] = Y.corner(nearest, 0);
+      if (nearest < 0) continue;
+      // Of its corners, the one furthest along N_f (the walk then starts there, without
+      // locate's step: that usually is the contributing vertex).
+      double top = -std::numeric_limits<double>::infinity();
+      for (int k = 0; k < Y.degree(nearest); ++k) {
+        const V3<double>& q = Y.points[Y.corner(nearest, k)];
+        const double h = n.x * q.x + n.y * q.y + n.z * q.z;
+        if (h > top) {
+          top = h;
+          starts[f] = Y.corner(nearest, k);
+        }
+      }
+      if (starts[f] < 0) starts[f] = Y.corner(nearest, 0);
     }
   });
   return starts;

@@ -42,6 +42,18 @@ const V3<ExactN>& Polytope::exact_normal(int f) const {
 
 namespace {
 
+/// Whether component i of a triangle's Newell normal, (q - p) x (r - p), is exactly zero by a
+/// cheap sufficient test: two corners coincide in projection onto the other two axes (the
+/// projected triangle is degenerate). A facet symmetric under the mirror x_i -> -x_i is such a
+/// triangle (the mirror fixes one corner and swaps the other two, which then differ only in
+/// x_i). False when the test does not show it.
+bool projection_degenerate(const V3<double>& p, const V3<double>& q, const V3<double>& r, int i) {
+  const double pp[3] = {p.x, p.y, p.z}, qq[3] = {q.x, q.y, q.z}, rr[3] = {r.x, r.y, r.z};
+  const int j = (i + 1) % 3, l = (i + 2) % 3;
+  return (pp[j] == qq[j] && pp[l] == qq[l]) || (qq[j] == rr[j] && qq[l] == rr[l]) ||
+         (rr[j] == pp[j] && rr[l] == pp[l]);
+}
+
 /// The precise normal of a facet with double points: the points scaled by a power of
 /// two (exactly) so the largest coordinate is about 1, Newell's sum in double-double. A
 /// component that might be zero is decided exactly (mirror-symmetric facets have exactly
@@ -106,6 +118,11 @@ PreciseNormal precise_newell(const std::vector<V3<double>>& points, const int* c
     // (|lo| adds 2u); doubled, plus an absolute term for underflow.
     n.error[i] = 8 * (operations + 1) * kU2 * magnitude[i] * 1.01 + 0x1p-1000;
     if (std::abs(n.hi[i]) <= n.error[i]) {
+      if (d == 3 &&
+          projection_degenerate(points[corners[0]], points[corners[1]], points[corners[2]], i)) {
+        n.hi[i] = n.lo[i] = n.error[i] = 0;
+        continue;
+      }
       const int j = (i + 1) % 3, l = (i + 2) % 3;
       ExactN component(0);
       for (int k = 0; k < d; ++k) {
@@ -272,10 +289,126 @@ int orient_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef
   return CGAL::sign(det(a.exact(), b.exact(), c.exact()));
 }
 
+namespace {
+
+/// projection_degenerate for facet f of P (a triangle with double points; false otherwise).
+bool component_surely_zero(const Polytope& P, int f, int i) {
+  if (P.degree(f) != 3 || !P.given_normals.empty()) return false;
+  const int* const c = &P.corner_vertex[P.face_begin[f]];
+  return projection_degenerate(P.points[c[0]], P.points[c[1]], P.points[c[2]], i);
+}
+
+/// N_x x N_y for a nearly parallel pair x, y, times a positive factor, as doubles w with a
+/// bound eps on their (Euclidean) distance to it: the cross product in double-double of x's and
+/// y's precise normals. False when a precise normal is not valid. Round-to-nearest (the
+/// caller's guard). With X, Y the precise normals (sigma_x N_x + E_x, sigma_y N_y + E_y,
+/// sigma > 0), W the computed X x Y and w its high parts:
+///  - |W - X x Y| <= 32 u^2 (|X_j Y_l| + |X_l Y_j|) per component (precise_newell's triangle
+///    bound: two products and a difference of double-doubles, doubled), with 1.01 for the
+///    rounding of the magnitudes and 2^-1000 for underflow;
+///  - |X x Y - sigma_x sigma_y N_x x N_y| <= |E_x| |Y| + |X*| |E_y| (length and error bounds);
+///  - |w - W| <= sum |lo|;
+/// eps sums the three (per-component bounds summed bound the Euclidean distance).
+bool precise_cross(const NormalRef& x, const NormalRef& y, double w[3], double& eps) {
+  const PreciseNormal& X = x.polytope->precise_normal(x.face);
+  const PreciseNormal& Y = y.polytope->precise_normal(y.face);
+  if (!X.valid || !Y.valid) return false;
+  auto dd = [](const PreciseNormal& n, int i) { return DD{n.hi[i], n.lo[i]}; };
+  eps = 0;
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3, l = (i + 2) % 3;
+    const DD c = dd(X, j) * dd(Y, l) - dd(X, l) * dd(Y, j);
+    const double magnitude =
+        std::abs(X.hi[j]) * std::abs(Y.hi[l]) + std::abs(X.hi[l]) * std::abs(Y.hi[j]);
+    w[i] = c.hi;
+    eps += 32 * kU2 * magnitude * 1.01 + 0x1p-1000 + std::abs(c.lo);
+  }
+  eps += error_bound(X) * length_bound(Y) + length_bound(X) * error_bound(Y);
+  return true;
+}
+
+/// Sign of z . (N_x x N_y) for a nearly parallel pair x, y (or kUndecided): precise_cross,
+/// dotted in doubles with z's unit normal. The far normal z needs no precise normal:
+/// det(x, y, z) of two nearly parallel normals is small because N_x x N_y is, and only that
+/// product needs the extra precision. For w within eps of W* (a positive multiple of
+/// N_x x N_y) and the unit normal z^ within e_z of z = N_z / |N_z| (|z| = 1), the double dot
+/// D = z^ . w satisfies |D - z . W*| <= |D - z^ . w| + e_z |w| + eps, with |D - z^ . w| <= 3
+/// ulps (any rounding) of sum |z^_i w_i| and |w| <= sum |w_i|: the bound below, with margins.
+/// z . W* has the sign of det(N_x, N_y, N_z).
+int orient_near_pair(const NormalRef& x, const NormalRef& y, const UnitNormal& z) {
+  double w[3], eps;
+  if (!std::isfinite(z.error) || !precise_cross(x, y, w, eps)) return kUndecided;
+  const double d = z.x * w[0] + z.y * w[1] + z.z * w[2];
+  const double size = std::abs(w[0]) + std::abs(w[1]) + std::abs(w[2]);
+  const double products = std::abs(z.x * w[0]) + std::abs(z.y * w[1]) + std::abs(z.z * w[2]);
+  const double bound = (z.error * size + eps + 4 * 0x1p-52 * products) * 1.01 + 0x1p-1000;
+  if (d > bound) return 1;
+  if (d < -bound) return -1;
+  return kUndecided;
+}
+
+/// Sign of (N_x x N_y) . (N_z x N_t) for a nearly parallel pair x, y (or kUndecided):
+/// precise_cross (w within eps of W*, a positive multiple of N_x x N_y), dotted in doubles with
+/// v = z^ x t^ from the unit normals. For the unit vectors z, t of N_z, N_t: |z^ x t^ - z x t|
+/// <= e_z |t^| + |z| e_t <= 1.01 e_z + e_t, and rounding v's components adds at most 2e-14
+/// (kUnitPredicateRounding's bound on such unit evaluations): |v - z x t| <= ev. Then the
+/// double dot D = w . v satisfies |D - W* . (z x t)| <= |D - w . v| + eps |v| + |W*| ev, with
+/// |D - w . v| <= 3 ulps of sum |w_i v_i|, |v| <= sum |v_i| and |W*| <= sum |w_i| + eps.
+int cross_dot_near_pair(const NormalRef& x, const NormalRef& y, const UnitNormal& z,
+                        const UnitNormal& t) {
+  double w[3], eps;
+  if (!std::isfinite(z.error) || !std::isfinite(t.error) || !precise_cross(x, y, w, eps))
+    return kUndecided;
+  const double v[3] = {z.y * t.z - z.z * t.y, z.z * t.x - z.x * t.z, z.x * t.y - z.y * t.x};
+  const double ev = 1.01 * z.error + t.error + kUnitPredicateRounding;
+  const double d = w[0] * v[0] + w[1] * v[1] + w[2] * v[2];
+  const double size_w = std::abs(w[0]) + std::abs(w[1]) + std::abs(w[2]);
+  const double size_v = std::abs(v[0]) + std::abs(v[1]) + std::abs(v[2]);
+  const double products = std::abs(w[0] * v[0]) + std::abs(w[1] * v[1]) + std::abs(w[2] * v[2]);
+  const double bound =
+      (eps * size_v + (size_w + eps) * ev + 4 * 0x1p-52 * products) * 1.01 + 0x1p-1000;
+  if (d > bound) return 1;
+  if (d < -bound) return -1;
+  return kUndecided;
+}
+
+}  // namespace
+
 int orient_normals_precise(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
   {
     // Double-double needs round-to-nearest, whatever the caller set.
     CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    // A component within the unit normals' error bounds of zero in all three may be exactly
+    // zero in all three (mirror-symmetric facets): then det is zero, shown cheaply for
+    // triangles by component_surely_zero, else by the full stage.
+    const UnitNormal &ua = a.unit(), &ub = b.unit(), &uc = c.unit();
+    const double pa[3] = {ua.x, ua.y, ua.z}, pb[3] = {ub.x, ub.y, ub.z}, pc[3] = {uc.x, uc.y, uc.z};
+    bool may_share_zero = false;
+    for (int i = 0; i < 3; ++i) {
+      if (!(std::abs(pa[i]) <= ua.error && std::abs(pb[i]) <= ub.error &&
+            std::abs(pc[i]) <= uc.error))
+        continue;
+      may_share_zero = true;
+      if (component_surely_zero(*a.polytope, a.face, i) &&
+          component_surely_zero(*b.polytope, b.face, i) &&
+          component_surely_zero(*c.polytope, c.face, i))
+        return 0;
+    }
+    // Otherwise what the double stage leaves undecided is mostly a nearly parallel pair (two
+    // fine spheres) with a far third normal: first orient_near_pair, which needs only the
+    // pair's precise normals (det(a, b, c) = c . (a x b) = a . (b x c) = b . (c x a), the pair
+    // the one whose unit normals' dot product is largest in magnitude). It cannot show a zero,
+    // so triples that may share a zero component go straight to the full stage.
+    if (!may_share_zero) {
+      auto dot = [](const UnitNormal& u, const UnitNormal& v) {
+        return std::abs(u.x * v.x + u.y * v.y + u.z * v.z);
+      };
+      const double ab = dot(ua, ub), bc = dot(ub, uc), ca = dot(uc, ua);
+      const int s = ab >= bc && ab >= ca ? orient_near_pair(a, b, uc)
+                    : bc >= ca           ? orient_near_pair(b, c, ua)
+                                         : orient_near_pair(c, a, ub);
+      if (s != kUndecided) return s;
+    }
     const PreciseNormal& p = a.polytope->precise_normal(a.face);
     const PreciseNormal& q = b.polytope->precise_normal(b.face);
     const PreciseNormal& r = c.polytope->precise_normal(c.face);
@@ -325,6 +458,17 @@ int cross_dot_normals_precise(const NormalRef& a, const NormalRef& b, const Norm
     // As orient_normals_undecided: double-double on precise normals (nearly parallel
     // normals give values far below what doubles resolve), in round-to-nearest.
     CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    // First as orient_normals_precise, from the nearly parallel pair's precise normals only
+    // (a x b or c x d, whichever pair's unit normals have the larger |dot|; the value is
+    // symmetric in the two cross products).
+    {
+      const UnitNormal &ua = a.unit(), &ub = b.unit(), &uc = c.unit(), &ud = d.unit();
+      const double ab = std::abs(ua.x * ub.x + ua.y * ub.y + ua.z * ub.z);
+      const double cd = std::abs(uc.x * ud.x + uc.y * ud.y + uc.z * ud.z);
+      const int s =
+          ab >= cd ? cross_dot_near_pair(a, b, uc, ud) : cross_dot_near_pair(c, d, ua, ub);
+      if (s != kUndecided) return s;
+    }
     const PreciseNormal& p = a.polytope->precise_normal(a.face);
     const PreciseNormal& q = b.polytope->precise_normal(b.face);
     const PreciseNormal& r = c.polytope->precise_normal(c.face);
