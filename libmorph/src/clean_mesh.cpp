@@ -260,27 +260,26 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
         if (off(c)) return false;
     return true;
   };
-  // The edges in order of their first corners, facet by facet (each corner's facet known).
-  for (int f = 0; f < nf; ++f)
-    for (int c = soup.begin[f]; c < soup.begin[f + 1]; ++c) {
-      const int t = k.twin[c];
-      if (t < c) continue;
-      int a = sets.find(f), b = sets.find(k.face[t]);
-      if (a == b) continue;
-      int edge_b = t;  // b's corner on the edge
-      if (geo[reference[a]].twice_area < geo[reference[b]].twice_area) {
-        std::swap(a, b);
-        edge_b = c;
-      }
-      // a has the larger reference facet.
-      if (!holds(reference[a], b, edge_b)) continue;
-      const int root = std::min(a, b), other = std::max(a, b);
-      sets.unite(a, b);  // names the joined set `root`
-      reference[root] = reference[a];
-      next_member[last_member[root]] = other;
-      last_member[root] = last_member[other];
-      out.merged = true;
+  const int nc = static_cast<int>(soup.vertex.size());
+  for (int c = 0; c < nc; ++c) {
+    const int t = k.twin[c];
+    if (t < c) continue;
+    int a = sets.find(k.face[c]), b = sets.find(k.face[t]);
+    if (a == b) continue;
+    int edge_b = t;  // b's corner on the edge
+    if (geo[reference[a]].twice_area < geo[reference[b]].twice_area) {
+      std::swap(a, b);
+      edge_b = c;
     }
+    // a has the larger reference facet.
+    if (!holds(reference[a], b, edge_b)) continue;
+    const int root = std::min(a, b), other = std::max(a, b);
+    sets.unite(a, b);  // names the joined set `root`
+    reference[root] = reference[a];
+    next_member[last_member[root]] = other;
+    last_member[root] = last_member[other];
+    out.merged = true;
+  }
   out.of.resize(nf);
   for (int f = 0; f < nf; ++f) out.of[f] = sets.find(f);
   return out;

@@ -400,20 +400,15 @@ namespace {
 /// number. `slot` is -1 at every vertex of B on entry, and 0 at those written on return
 /// (the caller numbers them there, then resets them).
 int distinct_partners(const int* partner, int b, int e, int* slot, int* out) {
-  // A vertex of A meets few vertices of B: each is put in its place as it is found (cheaper
-  // than sorting them after, for a few), up to kInserted; more are sorted at the end.
-  constexpr int kInserted = 32;
   int n = 0;
   for (int k = b; k < e; ++k) {
     const int j = partner[k];
-    if (slot[j] >= 0) continue;
-    slot[j] = 0;
-    int place = n++;
-    if (n <= kInserted)
-      for (; place > 0 && out[place - 1] > j; --place) out[place] = out[place - 1];
-    out[place] = j;
+    if (slot[j] < 0) {
+      slot[j] = 0;
+      out[n++] = j;
+    }
   }
-  if (n > kInserted) std::sort(out, out + n);
+  std::sort(out, out + n);
   return n;
 }
 
