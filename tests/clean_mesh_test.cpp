@@ -201,6 +201,53 @@ TEST_CASE("clean_mesh drops a needle folded by its short diagonal without the hu
   }
 }
 
+// The unit cube whose top takes a copy 8 of vertex 4 moved by `offset` along x, and a sliver
+// triangle 4, 8, 5 (its corners in each rotation, so that the close pair is at each place
+// among its three pairs) that is folded onto the edge 4-5 when 8 merges into 4. Pass 1 screens
+// triangles and quadrilaterals without a branch per pair: a close pair at any place must be
+// found, at any scale, and one beyond the feature size must not.
+TEST_CASE("clean_mesh finds a close pair at each place in a triangle, at any scale") {
+  for (const double scale : {1.0, 0x1p200, 0x1p-200}) {
+    for (const double shift : {0.0, 1000.0}) {
+      for (const std::vector<int>& sliver :
+           {std::vector<int>{4, 8, 5}, std::vector<int>{8, 5, 4}, std::vector<int>{5, 4, 8}}) {
+        for (const double offset : {1e-13, 1e-6}) {
+          CAPTURE(scale);
+          CAPTURE(shift);
+          CAPTURE(sliver);
+          CAPTURE(offset);
+          std::vector<V3<double>> points = cube_points();
+          points.push_back({offset, 0, 1});  // 8: vertex 4 moved
+          for (auto& p : points) p = {(p.x + shift) * scale, p.y * scale, p.z * scale};
+          const std::vector<std::vector<int>> facets = {
+              {0, 2, 3, 1}, {8, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3},
+              {0, 4, 6, 2}, {1, 3, 7, 5}, sliver,
+          };
+          std::vector<int> begin{0}, corners;
+          for (const auto& f : facets) {
+            corners.insert(corners.end(), f.begin(), f.end());
+            begin.push_back(static_cast<int>(corners.size()));
+          }
+          std::vector<int> source;
+          const long before = morph::detail::clean_mesh_hull_fallbacks();
+          const morph::Mesh mesh = clean_mesh(points, begin, corners, &source);
+          if (offset < 1e-9) {
+            // 8 merges into 4: the cube as given, the sliver gone, no hull.
+            CHECK(morph::detail::clean_mesh_hull_fallbacks() == before);
+            CHECK(mesh.n_vertices() == 8);
+            CHECK(mesh.n_faces() == 6);
+            for (auto f : mesh.faces()) CHECK(mesh.valence(f) == 4);
+            CHECK(std::find(source.begin(), source.end(), 6) == source.end());
+          } else {
+            // Nothing merges, and the edge 8 -> 5 is used twice: only the hull mends it.
+            CHECK(morph::detail::clean_mesh_hull_fallbacks() == before + 1);
+          }
+        }
+      }
+    }
+  }
+}
+
 // A (+) (A + t) with t rounded: the operands' facets are parallel up to the rounding, and
 // the exact sum has, along every edge of 2A, needles whose short diagonals merge (see the
 // test above). The result is 2A translated, from the regular path (no hull), and agrees

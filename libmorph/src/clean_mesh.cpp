@@ -72,7 +72,7 @@ class Ints {
 /// corner's vertex; twin[c] the corner of the opposite edge.
 struct Connectivity {
   Ints face, next, prev, twin;
-  Ints first_out;  // from `connect` only: the first corner leaving each point (-1: none)
+  Ints first_out;  // a corner leaving each point (-1: none); `connect`'s is the first one
 };
 
 // Chunk sizes of the parallel loops: large enough that a chunk pays for its task, small
@@ -205,7 +205,11 @@ FacetGeometry geometry(const std::vector<V3<double>>& points, const Soup& soup, 
     p = q;
   }
   g.longest_edge = std::sqrt(longest_squared);
-  centroid = {origin.x + centroid.x / d, origin.y + centroid.y / d, origin.z + centroid.z / d};
+  if (d == 4)  // x * 0.25 is x / 4 (both exact or both the same rounding), and cheaper
+    centroid = {origin.x + centroid.x * 0.25, origin.y + centroid.y * 0.25,
+                origin.z + centroid.z * 0.25};
+  else
+    centroid = {origin.x + centroid.x / d, origin.y + centroid.y / d, origin.z + centroid.z / d};
   g.twice_area = std::sqrt(dot(sum, sum));
   if (g.twice_area > 0) {
     g.normal = {sum.x / g.twice_area, sum.y / g.twice_area, sum.z / g.twice_area};
@@ -343,8 +347,10 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
       }
   const int nc = static_cast<int>(soup.vertex.size());
   Ints corner_group(nc);  // looked up several times per corner below
-  parallel_chunks(nc, kCornerGrain, [&](int first, int last) {
-    for (int c = first; c < last; ++c) corner_group[c] = groups.of[k.face[c]];
+  parallel_chunks(nf, kFacetGrain, [&](int first, int last) {
+    for (int f = first; f < last; ++f)
+      std::fill(corner_group.data() + soup.begin[f], corner_group.data() + soup.begin[f + 1],
+                groups.of[f]);
   });
   const auto group = [&](int c) { return corner_group[c]; };
   // Vertices keep their place when at least three groups meet there (each vertex walks
@@ -403,15 +409,22 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
   // vertex), with their group's largest facet: the only ones whose corners need a test. A
   // facet left as it is has no test when nothing merges either (the soup is kept then).
   std::vector<std::pair<int, int>> to_test;
+  // Plain pointers: the writes through them could alias the vectors' own pointers, which
+  // would then be loaded again for each corner.
+  const int* const vertex = soup.vertex.data();
+  const char* const kept = keep.data();
+  int *const out_vertex = out.vertex.data(), *const chain_of_data = chain_of.data(),
+             *const chain_end_data = chain_end.data();
   for (int g = 0; g < nf; ++g) {
     if (groups.of[g] != g) continue;
     const int first = size;
     int before_first = -1;  // the last corner walked before the first kept one
     const auto add = [&](int c) {
-      if (keep[soup.vertex[c]]) {
-        chain_of[c] = size;
-        out.vertex[size] = soup.vertex[c];
-        chain_end[size++] = c;
+      const int v = vertex[c];
+      if (kept[v]) {
+        chain_of_data[c] = size;
+        out_vertex[size] = v;
+        chain_end_data[size++] = c;
       } else if (size == first) {
         before_first = c;
       } else {
@@ -515,15 +528,22 @@ std::optional<Connectivity> connect_with(int num_points, const Soup& soup, Merge
   });
   if (!reverse.load()) return std::nullopt;
   std::vector<int> out_count(num_points, 0), marks(num_points, -1);
+  k.first_out = Ints(num_points);
+  std::fill_n(k.first_out.data(), num_points, -1);
   // Plain pointers: the writes through them could alias the arrays' own pointers.
   const int *vertex = soup.vertex.data(), *next = k.next.data(), *prev = k.prev.data(),
             *twins = k.twin.data();
-  int *count = out_count.data(), *mark = marks.data();
+  int *count = out_count.data(), *mark = marks.data(), *leaving = k.first_out.data();
   const char* check = merged.check_vertex.data();
-  for (int c = 0; c < nc; ++c) ++count[vertex[c]];
-  for (int s = 0; s < nc; ++s) {
-    const int v = vertex[s];
-    if (!check[v] || count[v] < 0) continue;  // its fan needs no check, or is checked
+  for (int c = 0; c < nc; ++c) {
+    ++count[vertex[c]];
+    leaving[vertex[c]] = c;
+  }
+  // The orbit below is the same cycle from any of its corners: the fans are checked from
+  // whichever corner is at hand, point by point.
+  for (int v = 0; v < num_points; ++v) {
+    if (!check[v] || count[v] == 0) continue;  // its fan needs no check, or is not used
+    const int s = leaving[v];
     // Turning from an outgoing edge to the next is a permutation of the corners leaving v:
     // one fan when its orbit holds all of them.
     int c = s, steps = 0;
@@ -535,7 +555,6 @@ std::optional<Connectivity> connect_with(int num_points, const Soup& soup, Merge
       ++steps;
     } while (c != s && steps <= count[v]);
     if (steps != count[v] || c != s) return std::nullopt;
-    count[v] = -1;
   }
   return k;
 }
@@ -671,15 +690,12 @@ Mesh build_serial(const std::vector<V3<double>>& points, const Soup& soup, const
   Mesh mesh;
   const int nc = static_cast<int>(soup.vertex.size());
   const int np = static_cast<int>(points.size());
-  std::vector<int> handle(np, -1);  // the mesh vertex of each point (-1: unused)
-  int num_edges = 0;
-  for (int c = 0; c < nc; ++c) {
-    handle[soup.vertex[c]] = 0;
-    num_edges += k.twin[c] >= c;
-  }
+  // The used points are those with a corner leaving them; the corners pair up into edges
+  // (twins are mutual and distinct in a closed manifold soup).
+  std::vector<int> handle(np);  // the mesh vertex of each point (-1: unused)
+  const int num_edges = nc / 2;
   int num_used = 0;
-  for (int v = 0; v < np; ++v)
-    if (handle[v] >= 0) handle[v] = num_used++;
+  for (int v = 0; v < np; ++v) handle[v] = k.first_out[v] >= 0 ? num_used++ : -1;
   // Every element at once: OpenMesh grows each of its property arrays per added element.
   // The elements are numbered as add_vertex, new_edge and new_face would number them.
   mesh.resize(num_used, num_edges, soup.size());
@@ -919,6 +935,31 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
       for (int c = b; c < e; ++c) pair(corners[c], corners[c + 1 == e ? b : c + 1]);
     }
   };
+  // Triangles and quadrilaterals (nearly all facets): no pair is close when none is within
+  // `far` nor repeated, decided from their points loaded once and without a branch per pair
+  // (`close` of a pair is false unless its squared distance is at most `far`).
+  const auto squared = [&](const V3<double>& p, const V3<double>& q) {
+    const V3<double> d = p - q;
+    return dot(d, d);
+  };
+  auto surely_apart = [&](int f) {
+    const int b = face_begin[f], e = face_begin[f + 1];
+    const int* v = corners.data() + b;
+    if (e - b == 3) {
+      const V3<double>&p0 = points[v[0]], &p1 = points[v[1]], &p2 = points[v[2]];
+      return !((squared(p0, p1) <= far) | (squared(p0, p2) <= far) | (squared(p1, p2) <= far) |
+               (v[0] == v[1]) | (v[0] == v[2]) | (v[1] == v[2]));
+    }
+    if (e - b == 4) {
+      const V3<double>&p0 = points[v[0]], &p1 = points[v[1]], &p2 = points[v[2]],
+            &p3 = points[v[3]];
+      return !((squared(p0, p1) <= far) | (squared(p0, p2) <= far) | (squared(p0, p3) <= far) |
+               (squared(p1, p2) <= far) | (squared(p1, p3) <= far) | (squared(p2, p3) <= far) |
+               (v[0] == v[1]) | (v[0] == v[2]) | (v[0] == v[3]) | (v[1] == v[2]) | (v[1] == v[3]) |
+               (v[2] == v[3]));
+    }
+    return false;
+  };
   // The facets with close corners (few), found in parallel; their unions follow in order.
   // A corner repeated in a facet compared pair by pair marks it too (it is close to itself
   // unless its point is not finite): the facets are then not the soup as they are, and the
@@ -929,7 +970,8 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
     bool found = false;
     for (int f = first; f < last; ++f) {
       bool here = false;
-      for_pairs(f, [&](int u, int w) { here = here || u == w || close(u, w); });
+      if (!surely_apart(f))
+        for_pairs(f, [&](int u, int w) { here = here || u == w || close(u, w); });
       has_close[f] = here;
       found = found || here;
     }
