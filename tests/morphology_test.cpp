@@ -506,3 +506,21 @@ TEST_CASE("morph: a non-convex operand is rejected, naming it") {
     }
   }
 }
+
+TEST_CASE("morph: an error inside a thread arena propagates, and later results are whole") {
+  // With a thread count the result is made in place inside the arena (execute_in_place):
+  // when the operation throws there, the exception must still reach the caller intact.
+  const Mesh dented = mesh_from_polygons(
+      {Point(0, 0, 0), Point(2, 0, 0), Point(0, 2, 0), Point(0, 0, 2), Point(0.5, 0.5, 0.3)},
+      {{0, 1, 3}, {1, 2, 3}, {2, 0, 3}, {0, 2, 4}, {2, 1, 4}, {1, 0, 4}});
+  const Mesh reference = minkowski_sum(cube(1.0), cube(0.5), {}).mesh;
+  for (int threads : {1, 2}) {
+    CAPTURE(threads);
+    CHECK_THROWS_AS((void)minkowski_sum(dented, cube(0.1), {.threads = threads}), invalid_mesh);
+    for (auto op : {&morph::erode, &morph::dilate, &morph::open, &morph::close})
+      CHECK_THROWS_AS((void)op(cube(1.0), dented, {.threads = threads}), invalid_mesh);
+    const LabelledMesh sum = minkowski_sum(cube(1.0), cube(0.5), {.threads = threads});
+    CHECK(identical(sum.mesh, reference));
+    CHECK(sum.origins.size() == sum.mesh.n_faces());
+  }
+}
