@@ -11,6 +11,7 @@
 #include <map>
 #include <sstream>
 
+#include "common/allocator.h"
 #include "common/batch.h"
 #include "common/cli.h"
 #include "common/job.h"
@@ -308,6 +309,7 @@ int run(int argc, const char* const argv[], Reporter& reporter) {
 }  // namespace
 
 int main(int argc, char* argv[]) {
+  keep_freed_memory();
   Reporter reporter(kProgram);
   try {
     return run(argc, argv, reporter);

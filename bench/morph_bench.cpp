@@ -15,6 +15,8 @@
 //                                A and B are sample files, B = "rotated" is A turned as in Table 1
 //   --op erode|open|close        before --loop: loop this operation instead (B scaled as in the
 //                                morphology rows)
+//   --malloc-defaults            keep glibc's allocator defaults (by default the bench, like the
+//                                apps, keeps freed memory for reuse: common/allocator.h)
 //
 // Every measurement runs once as a warm-up (not counted), then repeats as many times as
 // fit in the budget (3 to 15 times) and reports the median. The hull route is what a user
@@ -28,6 +30,8 @@
 #include <morph/morphology.h>
 #include <morph/structuring_element.h>
 #include <sys/resource.h>
+
+#include "common/allocator.h"
 #include <unistd.h>
 
 #include <algorithm>
@@ -591,18 +595,24 @@ std::string load_average() {
   return fixed(one, 2) + " " + fixed(five, 2) + " " + fixed(fifteen, 2);
 }
 
+bool g_malloc_defaults = false;  // --malloc-defaults
+
 std::string machine() {
   std::ostringstream out;
   out << "Machine: " << cpu_model() << ", " << std::thread::hardware_concurrency()
       << " hardware threads (nproc " << sysconf(_SC_NPROCESSORS_ONLN) << "); load average at start "
-      << load_average() << "\n\n";
+      << load_average() << "; allocator: "
+      << (g_malloc_defaults ? "glibc defaults (--malloc-defaults)"
+                            : "freed memory kept for reuse (glibc trim threshold 64 MB, mmap "
+                              "threshold 32 MB, as in the apps)")
+      << "\n\n";
   return out.str();
 }
 
 void usage(std::ostream& out) {
   out << "usage: morph-bench [--table1] [--morphology] [--scaling] [--all]\n"
          "                   [--csv DIR] [--markdown FILE] [--samples DIR] [--budget SECONDS]\n"
-         "                   [--filter TEXT]\n"
+         "                   [--filter TEXT] [--malloc-defaults]\n"
          "       morph-bench [--samples DIR] [--op OP] --loop A.off B.off|rotated SECONDS "
          "[THREADS]\n"
          "  no selection: Table 1, morphology and a quick scaling run\n";
@@ -614,6 +624,10 @@ int main(int argc, char** argv) {
   try {
     Settings settings;
     const std::vector<std::string> args(argv + 1, argv + argc);
+    // Before any allocation of either route: both are timed with the same allocator settings.
+    g_malloc_defaults =
+        std::find(args.begin(), args.end(), "--malloc-defaults") != args.end();
+    if (!g_malloc_defaults) morph::cli::keep_freed_memory();
     if (args.size() == 3 && args[0] == "--peak-case")
       return run_peak_case(args[1], std::stoi(args[2]));
     for (std::size_t i = 0; i < args.size(); ++i) {
@@ -640,6 +654,8 @@ int main(int argc, char** argv) {
         settings.budget_seconds = std::stod(value());
       else if (arg == "--filter")
         settings.filter = value();
+      else if (arg == "--malloc-defaults")
+        continue;  // handled above
       else if (arg == "--op")
         settings.loop_op = value();
       else if (arg == "--loop") {

@@ -1,5 +1,7 @@
 #include "options.h"
 
+#include "allocator.h"
+
 #include <morph/error.h>
 #include <morph/io.h>
 #include <morph/structuring_element.h>
@@ -155,6 +157,7 @@ std::string operation_usage(const std::string& program, Op op,
 }  // namespace
 
 int run_operation_app(int argc, const char* const argv[], Op op) {
+  keep_freed_memory();
   const std::string program = std::string("mesh-") + op_name(op);
   Reporter reporter(program);
   install_interrupt_handler(program, InterruptMode::immediate_when_safe);
