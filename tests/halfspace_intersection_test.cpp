@@ -682,6 +682,55 @@ TEST_CASE("halfspace_intersection: an erosion's guess on tiny, huge and far oper
     CHECK(r.polytope->num_faces() == A.num_faces());
   }
 }
+
+// Vertices of high degree (a UV sphere's poles, a cone's apex) are triangulated first and
+// their triangles' vertices tested against the planes nearby, which rejects a guess early
+// where facets vanish near them (the UV sphere's thin facets at the poles) and must keep a
+// right one (a small element; one 2^-40 times A's size, whose opened-up vertices lie within
+// rounding of each other, so exact signs decide): scaled by 2^+-200 and far from the origin,
+// each result the hull's and the exact route's.
+TEST_CASE("halfspace_intersection: an erosion's guess near vertices of high degree") {
+  const morph::Mesh& uv = sample("uvsphere_1600.off");
+  const morph::Mesh snub = morph::test::scaled(sample("snub_dodecahedron.off"), 0.25);
+  std::vector<morph::Point> cone_points{{0, 0, 1}};
+  for (int i = 0; i < 48; ++i) {
+    const double t = 2 * M_PI * i / 48;
+    cone_points.push_back({std::cos(t), std::sin(t), -1});
+  }
+  const morph::Mesh cone = morph::test::convex_hull_mesh(cone_points);
+  const morph::Mesh ball =
+      morph::test::transformed(sample("icosphere_80.off"), morph::test::random_rotation(5));
+  struct Case {
+    const char* what;
+    morph::Mesh A, B;
+    bool vanish;  // facets of A vanish: the guess is rejected
+  };
+  const Case cases[] = {
+      {"uvsphere by a snub dodecahedron", uv, snub, true},
+      {"uvsphere scaled by 2^200", morph::test::scaled(uv, 0x1p200),
+       morph::test::scaled(snub, 0x1p200), true},
+      {"uvsphere scaled by 2^-200", morph::test::scaled(uv, 0x1p-200),
+       morph::test::scaled(snub, 0x1p-200), true},
+      {"uvsphere far from the origin", morph::test::translated(uv, {1e6, -3e5, 7e5}), snub, true},
+      {"uvsphere by a small ball", uv, morph::test::scaled(ball, 1.0 / 64), false},
+      {"uvsphere by a ball 2^-40", uv, morph::test::scaled(ball, 0x1p-40), false},
+      {"cone by a ball 2^-40", cone, morph::test::scaled(ball, 0x1p-40), false},
+      {"cone scaled by 2^200", morph::test::scaled(cone, 0x1p200),
+       morph::test::scaled(ball, 0x1p190), false},
+      {"cone scaled by 2^-200", morph::test::scaled(cone, 0x1p-200),
+       morph::test::scaled(ball, 0x1p-210), false},
+      {"cone far from the origin", morph::test::translated(cone, {1e6, -3e5, 7e5}),
+       morph::test::scaled(ball, 1.0 / 64), false},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(std::string(c.what));
+    const Polytope A = make_operand(c.A, "A");
+    const MaybePolytope r = eroded_three_ways(A, make_operand(c.B, "B"));
+    REQUIRE(r.polytope);
+    CHECK((r.route == HullRoute::expected) == !c.vanish);
+    CHECK((r.polytope->num_faces() < A.num_faces()) == c.vanish);
+  }
+}
 namespace {
 
 /// The exact value of a dyadic ExactN as a rational.

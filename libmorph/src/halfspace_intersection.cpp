@@ -1661,6 +1661,10 @@ struct PolygonScratch {
 /// take O(k^2) on a vertex of A of high degree, and the hull is then the cheaper route.
 constexpr int kFlipsPerCorner = 4;
 
+/// Polygons of more planes than this are triangulated first, and tested against the planes
+/// nearby (expected_surface).
+constexpr int kLargePolygon = 8;
+
 /// Triangulates the polygon of planes p[0 .. k) (counter-clockwise seen from outside) so
 /// that it is locally convex, as the dual hull is: Lawson flips from a fan. The diagonal
 /// (a, c) between triangles (a, c, b) and (c, a, d) is flipped to (b, d) when plane d cuts
@@ -1791,15 +1795,72 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const PrecisePlan
     s.has_vertex.assign(nt, 0);
   }
   std::atomic<bool> ok = true;
-  parallel_chunks(nv, 64, [&](int begin, int end) {
+  const auto triangulate = [&](int v, PolygonScratch& scratch) {
+    if (!triangulate_polygon(planes, precise, known, &expected.facets[expected.begin[v]],
+                             expected.begin[v + 1] - expected.begin[v], expected.split,
+                             &s.corner[first[v]], expected.split ? &s.vertex[first[v]] : nullptr,
+                             expected.split ? &s.has_vertex[first[v]] : nullptr, scratch))
+      ok = false;
+  };
+  // Polygons of many planes first, each with a test that rejects a doomed guess early: where
+  // facets of A vanish (the thin facets around the pole of a UV sphere), a vertex of such a
+  // polygon's triangles is cut off by a plane of a polygon nearby. The planes of the polygons
+  // that share a plane with it are tested at its triangles' vertices; one that cuts a vertex
+  // off (side > 0, exactly) proves the guess wrong (a right one has every triangle's vertex
+  // a vertex of the intersection, inside every half-space), and the hull is computed without
+  // triangulating the rest. Each polygon's triangles do not depend on the order.
+  const auto size = [&](int v) { return expected.begin[v + 1] - expected.begin[v]; };
+  std::vector<int> large_polygons;
+  if (expected.split)
+    for (int v = 0; v < nv; ++v)
+      if (size(v) > kLargePolygon) large_polygons.push_back(v);
+  if (!large_polygons.empty()) {
+    // The polygons through each plane (a counting sort of the expected facets).
+    const int n = static_cast<int>(planes.size());
+    std::vector<int> through_begin(n + 1, 0), through(expected.facets.size());
+    for (int i : expected.facets) ++through_begin[i + 1];
+    std::partial_sum(through_begin.begin(), through_begin.end(), through_begin.begin());
+    {
+      std::vector<int> next(through_begin.begin(), through_begin.end() - 1);
+      for (int v = 0; v < nv; ++v)
+        for (int j = expected.begin[v]; j < expected.begin[v + 1]; ++j)
+          through[next[expected.facets[j]]++] = v;
+    }
+    parallel_chunks(static_cast<int>(large_polygons.size()), 1, [&](int begin, int end) {
+      RoundingGuard guard;
+      PolygonScratch scratch;
+      std::vector<int> nearby;
+      for (int j = begin; j < end && ok; ++j) {
+        const int v = large_polygons[j];
+        triangulate(v, scratch);
+        if (!ok) break;
+        const int* p = &expected.facets[expected.begin[v]];
+        nearby.clear();
+        for (int i = 0; i < size(v); ++i)
+          for (int w = through_begin[p[i]]; w < through_begin[p[i] + 1]; ++w)
+            for (int c = expected.begin[through[w]]; c < expected.begin[through[w] + 1]; ++c)
+              if (std::find(p, p + size(v), expected.facets[c]) == p + size(v))
+                nearby.push_back(expected.facets[c]);
+        std::sort(nearby.begin(), nearby.end());
+        nearby.erase(std::unique(nearby.begin(), nearby.end()), nearby.end());
+        for (int t = first[v]; t < first[v + 1] && ok; ++t) {
+          HVertex& x = s.vertex[t];
+          // (W > 0 for the sign below: a known point, or positive by intervals.)
+          if (!s.has_vertex[t] || (x.known < 0 && !(x.Wi.inf() > 0))) continue;
+          for (int i : nearby)
+            if (!known_through(known, i, x) && side(planes, precise, i, x) > 0) {
+              ok = false;
+              break;
+            }
+        }
+      }
+    });
+  }
+  parallel_chunks(ok ? nv : 0, 64, [&](int begin, int end) {
     RoundingGuard guard;
     PolygonScratch scratch;
     for (int v = begin; v < end && ok; ++v)
-      if (!triangulate_polygon(planes, precise, known, &expected.facets[expected.begin[v]],
-                               expected.begin[v + 1] - expected.begin[v], expected.split,
-                               &s.corner[first[v]], expected.split ? &s.vertex[first[v]] : nullptr,
-                               expected.split ? &s.has_vertex[first[v]] : nullptr, scratch))
-        ok = false;
+      if (large_polygons.empty() || size(v) <= kLargePolygon) triangulate(v, scratch);
   });
   if (!ok) return {};
   // Directed edges 3 t + k (corner k to k + 1 of triangle t) listed by their first plane
