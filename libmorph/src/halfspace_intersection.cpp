@@ -1369,6 +1369,7 @@ class IncrementalHull {
     int precise = -1;  // its precise coordinates in precise_vertex_, once tried (-2: none)
     int known = -1;    // the known point it is, if any (KnownPoints)
     int pending = -1;  // first of the planes that see it (linked by next_pending_)
+    int replaced = -1;  // once removed: a new triangle made on one of its horizon edges
     bool alive = true;
   };
   struct ExactVertex {
@@ -1378,17 +1379,26 @@ class IncrementalHull {
 
   const Plane& plane(int i) const { return i < n_ ? planes_[i] : virtual_[i - n_]; }
 
-  int add(int a, int b, int c) {
+  /// Adds triangle (a, b, c) with the cross products of its corners' normals along its edges
+  /// (edge k, corner k to k + 1: ab = n_a x n_b, bc, ca), kept for the triangles made next
+  /// to it (edge_cross_).
+  int add(int a, int b, int c, const V3<Interval>& ab, const V3<Interval>& bc,
+          const V3<Interval>& ca) {
     Tri t;
     t.c = {a, b, c};
     t.across = {-1, -1, -1};
-    const Plane &pa = plane(a), &pb = plane(b), &pc = plane(c);
-    meet(pa.ni, pa.di, pb.ni, pb.di, pc.ni, pc.di, t.Xi, t.Wi);
+    const Plane& pa = plane(a);
+    meet_of_crosses(pa.ni, pa.di, plane(b).di, plane(c).di, bc, ca, ab, t.Xi, t.Wi);
     // Three planes through a known point with independent normals (W > 0) meet there.
     if (!known_.empty() && a < n_ && b < n_ && c < n_ && t.Wi.inf() > 0)
       t.known = known_.common(a, b, c);
     tris_.push_back(t);
+    edge_cross_.push_back({ab, bc, ca});
     return static_cast<int>(tris_.size()) - 1;
+  }
+  int add(int a, int b, int c) {
+    const V3<Interval> &na = plane(a).ni, &nb = plane(b).ni, &nc = plane(c).ni;
+    return add(a, b, c, cross(na, nb), cross(nb, nc), cross(nc, na));
   }
 
   int side_of(int p, int t) {
@@ -1443,6 +1453,8 @@ class IncrementalHull {
   void start() {
     const int n = n_;
     tris_.reserve(8 * static_cast<std::size_t>(n) + 16);
+    edge_cross_.reserve(tris_.capacity());
+    around_cross_.resize(n + 4);
     // Around vertex n + 3 (det of the other three normals > 0 in this order).
     const int t0 = add(n, n + 1, n + 2), t1 = add(n + 1, n, n + 3), t2 = add(n + 2, n + 1, n + 3),
               t3 = add(n, n + 2, n + 3);
@@ -1490,16 +1502,27 @@ class IncrementalHull {
     // One new triangle (u, w, p) per horizon edge u -> w, linked around p.
     created_.clear();
     bool ok = true;
+    // Each new triangle (u, w, p) needs n_u x n_w (the removed triangle's, along its edge
+    // u -> w), n_w x n_p and n_p x n_u: the last computed once per horizon vertex u
+    // (around_cross_), the other the next triangle's negated (negation is exact: the same
+    // intervals as computed afresh). A w that starts no horizon edge fails the insertion below.
+    const V3<Interval>& np = plane(p).ni;
+    for (const auto& [t, k] : horizon_) {
+      const int u = tris_[t].c[k];
+      around_cross_[u] = cross(np, plane(u).ni);
+    }
+    const auto negated = [](const V3<Interval>& v) { return V3<Interval>{-v.x, -v.y, -v.z}; };
     for (const auto& [t, k] : horizon_) {
       const int u = tris_[t].c[k], w = tris_[t].c[(k + 1) % 3];
       const int kept = tris_[t].across[k];
-      const int nt = add(u, w, p);
+      const int nt = add(u, w, p, edge_cross_[t][k], negated(around_cross_[w]), around_cross_[u]);
       tris_[nt].across[0] = kept;
       int j = 0;
       while (j < 3 && tris_[kept].across[j] != t) ++j;
       if (j == 3 || start_at_[u] >= 0) ok = false;
       if (!ok) break;
       tris_[kept].across[j] = nt;
+      tris_[t].replaced = nt;
       start_at_[u] = nt;
       created_.push_back(nt);
     }
@@ -1518,8 +1541,16 @@ class IncrementalHull {
         next = next_pending_[q];
         conflict_[q] = -1;
         if (q == p) continue;
+        // The new triangle made on t's horizon edge first (q saw t, and often sees what
+        // replaced it), then the others in order. Which one q records does not change the
+        // hull: the visible triangles found from any of them are the same.
+        const int near = tris_[t].replaced;
+        if (near >= 0 && side_of(q, near) > 0) {
+          see(q, near);
+          continue;
+        }
         for (int nt : created_) {
-          if (side_of(q, nt) > 0) {
+          if (nt != near && side_of(q, nt) > 0) {
             see(q, nt);
             break;
           }
@@ -1536,6 +1567,8 @@ class IncrementalHull {
   int n_;
   std::array<Plane, 4> virtual_;
   std::vector<Tri> tris_;
+  std::vector<std::array<V3<Interval>, 3>> edge_cross_;  // per triangle: ab, bc, ca (add)
+  std::vector<V3<Interval>> around_cross_;  // per plane: n_p x n_u around the inserted p
   std::deque<ExactVertex> exact_;
   std::deque<HVertex> precise_vertex_;
   std::vector<int> conflict_, next_pending_;  // per real plane
