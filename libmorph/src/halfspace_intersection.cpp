@@ -1357,6 +1357,39 @@ class IncrementalHull {
     for (const Tri& t : tris_)
       if (t.alive)
         out.across.push_back({index[t.across[0]], index[t.across[1]], index[t.across[2]]});
+    // Each triangle's vertex for the check, as far as the run computed it (the intervals of
+    // its meet, its precise and exact coordinates, its known point); one whose W is not
+    // positive by intervals is left to the check.
+    out.vertex.resize(out.corner.size());
+    out.has_vertex.assign(out.corner.size(), 0);
+    for (std::size_t t = 0; t < tris_.size(); ++t) {
+      const Tri& tri = tris_[t];
+      if (!tri.alive || !(tri.Wi.inf() > 0)) continue;
+      HVertex& v = out.vertex[index[t]];
+      v.planes = tri.c;
+      if (tri.known >= 0) {
+        set_known(known_, tri.known, v);
+      } else {
+        v.Xi = tri.Xi;
+        v.Wi = tri.Wi;
+        v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
+        if (tri.precise >= 0) {
+          const HVertex& q = precise_vertex_[tri.precise];
+          v.px = q.px;
+          v.pw = q.pw;
+          v.ex = q.ex;
+          v.ew = q.ew;
+          v.precise = true;
+        }
+        v.precise_tried = tri.precise != -1;
+        if (tri.exact >= 0) {
+          v.X = exact_[tri.exact].X;
+          v.W = exact_[tri.exact].W;
+          v.has_exact = true;
+        }
+      }
+      out.has_vertex[index[t]] = 1;
+    }
     return Outcome::hull;
   }
 
