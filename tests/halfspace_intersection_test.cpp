@@ -1142,3 +1142,50 @@ TEST_CASE("halfspace_intersection: openings with exact points on demand are the 
   };
   for (const auto& [A, B] : cases) check_opening_routes(make_operand(A, "A"), make_operand(B, "B"));
 }
+
+// A triangle's normal in double-double straight from its double corners (set_normal_dd)
+// against the exact cross product: each component within 2^-101 of its |hi| whenever it is
+// set, on random, nearly degenerate (nearly collinear corners: cancellation in every
+// component), 2^+-200-scaled and far-shifted triangles; set for many of them.
+TEST_CASE("halfspace_intersection: a triangle's double-double normal is within its bound") {
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  int set = 0, total = 0;
+  for (int scale : {0, 200, -200}) {
+    for (double shift : {0.0, 1e6, -3e9}) {
+      for (int kind = 0; kind < 3; ++kind) {
+        for (int trial = 0; trial < 200; ++trial) {
+          const auto point = [&](double s) {
+            return V3<double>{std::ldexp(shift + s * unit(rng), scale),
+                              std::ldexp(shift + s * unit(rng), scale),
+                              std::ldexp(s * unit(rng), scale)};
+          };
+          V3<double> p0 = point(1), p1 = point(1), p2 = point(1);
+          if (kind == 1) {  // nearly collinear: p2 next to the midpoint of p0 p1
+            for (double V3<double>::*c : {&V3<double>::x, &V3<double>::y, &V3<double>::z})
+              p2.*c = std::nextafter(p0.*c / 2 + p1.*c / 2, HUGE_VAL);
+          } else if (kind == 2) {  // a tiny triangle, ulps apart
+            p1 = {std::nextafter(p0.x, HUGE_VAL), p0.y, std::nextafter(p0.z, -HUGE_VAL)};
+            p2 = {p0.x, std::nextafter(p0.y, HUGE_VAL), std::nextafter(p0.z, HUGE_VAL)};
+          }
+          HalfSpace h;
+          h.normal = cross(to_exact_n(p1) - to_exact_n(p0), to_exact_n(p2) - to_exact_n(p0));
+          set_normal_dd(h, p0, p1, p2);
+          ++total;
+          if (!h.has_normal_dd) continue;
+          ++set;
+          const ExactN* exact[3] = {&h.normal.x, &h.normal.y, &h.normal.z};
+          for (int k = 0; k < 3; ++k) {
+            const DD& d = h.normal_dd[k];
+            const Exact diff = Exact(*exact[k]) - Exact(d.hi) - Exact(d.lo);
+            const Exact error = diff < 0 ? -diff : diff;
+            CHECK(error <= Exact(std::abs(d.hi)) * Exact(0x1p-101));
+            CHECK(std::abs(d.lo) <= std::abs(d.hi) * 0x1p-52);
+          }
+        }
+      }
+    }
+  }
+  CHECK(set > 0);
+  MESSAGE("double-double normals set for " << set << " of " << total << " triangles");
+}

@@ -210,6 +210,9 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
         // its corners lie exactly on that plane, and h_A - h_B = <n, p - b> in one dot
         // product; differences of doubles as exact_difference.
         h.normal = triangle_normal(A, f);
+        // Its double-double copy from the doubles (cheaper than from the exact value).
+        set_normal_dd(h, A.points[A.corner(f, 0)], A.points[A.corner(f, 1)],
+                      A.points[A.corner(f, 2)]);
         h.offset = dot(h.normal, exact_difference(A.points[A.corner(f, 0)], B.points[b]));
         on[0] = on[1] = on[2] = 1;
         // Another candidate c attains h_B iff <n, c - b> = 0.
@@ -235,8 +238,8 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
         int sign;
         {
           RoundingGuard guard;
-          sign = interval_sign(dot(to_interval_n(h.normal),
-                                   to_interval(corner(1)) - to_interval(corner(0))));
+          sign = interval_sign(
+              dot(to_interval_n(h.normal), to_interval(corner(1)) - to_interval(corner(0))));
         }
         if (sign == 2) sign = CGAL::sign(dot(h.normal, exact_difference(corner(1), corner(0))));
         const int top = sign > 0 ? 1 : 0;

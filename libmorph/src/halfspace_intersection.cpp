@@ -73,6 +73,7 @@ struct Plane {
   ExactN d;
   V3<Interval> ni;
   Interval di;
+  const HalfSpace* source = nullptr;  // its normal's double-double copy, when it has one
 };
 
 std::vector<Plane> planes_of(const std::vector<HalfSpace>& hs) {
@@ -85,6 +86,7 @@ std::vector<Plane> planes_of(const std::vector<HalfSpace>& hs) {
       p.n = q == 1 ? hs[i].normal
                    : V3<ExactN>{hs[i].normal.x * q, hs[i].normal.y * q, hs[i].normal.z * q};
       p.d = hs[i].offset;
+      if (q == 1 && hs[i].has_normal_dd) p.source = &hs[i];
       p.ni = to_interval_n(p.n);
       p.di = to_interval_n(p.d);
     }
@@ -307,11 +309,18 @@ constexpr double kPlaneRelative = 0x1p-100;
 /// the power of two that brings the largest |c[k]|, k in [lead_begin, lead_end), into
 /// [1, 2); false when a value is beyond 2^400 or a non-zero one below 2^-900 after that
 /// (round-to-nearest).
+/// `given`, when not null, holds c[0] .. c[2] already in double-double, each within
+/// kPlaneRelative / 2 of its |hi| (HalfSpace::normal_dd).
 bool precise_scaled(const std::array<const ExactN*, 4>& c, int lead_begin, int lead_end,
-                    std::array<DD, 4>& out) {
+                    std::array<DD, 4>& out, const std::array<DD, 3>* given = nullptr) {
   std::array<DD, 4> v{};
   double largest = 0;
   for (int k = 0; k < 4; ++k) {
+    if (given && k < 3) {
+      v[k] = (*given)[k];
+      if (k >= lead_begin && k < lead_end) largest = std::max(largest, std::abs(v[k].hi));
+      continue;
+    }
     if (CGAL::sign(*c[k]) == CGAL::ZERO) continue;
     double error;
     v[k] = to_dd(*c[k], error);
@@ -340,7 +349,8 @@ struct PrecisePlane {
 };
 PrecisePlane precise_plane(const Plane& plane) {
   PrecisePlane p;
-  p.valid = precise_scaled({&plane.n.x, &plane.n.y, &plane.n.z, &plane.d}, 0, 3, p.c);
+  p.valid = precise_scaled({&plane.n.x, &plane.n.y, &plane.n.z, &plane.d}, 0, 3, p.c,
+                           plane.source ? &plane.source->normal_dd : nullptr);
   return p;
 }
 V3<DD> normal_dd(const PrecisePlane& p) { return {p.c[0], p.c[1], p.c[2]}; }
@@ -1695,6 +1705,48 @@ PreciseProbe probe_precise_point(const V3<ExactN>& X, const ExactN& W) {
   make_precise(PrecisePlanes(none), v);
   probe_rounding(v, out);
   return out;
+}
+
+void set_normal_dd(HalfSpace& h, const V3<double>& p0, const V3<double>& p1,
+                   const V3<double>& p2) {
+  CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+  // The edge vectors, each difference exact (two_sum's error term zero, no overflow).
+  V3<double> e1, e2;
+  const auto difference = [](double a, double b, double& out) {
+    const DD s = two_sum(a, -b);
+    out = s.hi;
+    return s.lo == 0 && std::abs(s.hi) <= 0x1p900;
+  };
+  if (!difference(p1.x, p0.x, e1.x) || !difference(p1.y, p0.y, e1.y) ||
+      !difference(p1.z, p0.z, e1.z) || !difference(p2.x, p0.x, e2.x) ||
+      !difference(p2.y, p0.y, e2.y) || !difference(p2.z, p0.z, e2.z))
+    return;
+  // Each component is a b - c d of doubles: both products exact by two_prod (factors below
+  // 2^900, each non-zero product at least 2^-900 in magnitude: no overflow, no underflow), and
+  // a.hi - c.hi exact by two_sum. The rest, s.lo + (a.lo - c.lo), errs by u = 2^-53 of each
+  // of its two rounded operations' results; the last two_sum is exact. So the value is within
+  // u (|t| + |r|) of hi + lo, which must be within 2^-101 of |hi| (else the normal is left
+  // to its exact conversion).
+  const auto component = [](double a, double b, double c, double d, DD& out) {
+    for (double x : {a, b, c, d})
+      if (!(std::abs(x) <= 0x1p900)) return false;
+    const DD p = two_prod(a, b), q = two_prod(c, d);
+    const auto in_range = [](double x, double y, double product) {
+      return x == 0 || y == 0 || (std::abs(product) >= 0x1p-900 && std::abs(product) <= 0x1p990);
+    };
+    if (!in_range(a, b, p.hi) || !in_range(c, d, q.hi)) return false;
+    const DD s = two_sum(p.hi, -q.hi);
+    const double t = p.lo - q.lo, r = s.lo + t;
+    out = two_sum(s.hi, r);
+    const double error = 0x1p-53 * (std::abs(t) + std::abs(r)) * 1.01;
+    return error <= 0x1p-101 * std::abs(out.hi);
+  };
+  std::array<DD, 3> n;
+  if (component(e1.y, e2.z, e1.z, e2.y, n[0]) && component(e1.z, e2.x, e1.x, e2.z, n[1]) &&
+      component(e1.x, e2.y, e1.y, e2.x, n[2])) {
+    h.normal_dd = n;
+    h.has_normal_dd = true;
+  }
 }
 
 HalfSpace make_halfspace(const V3<ExactN>& normal, const Exact& offset, int source) {
