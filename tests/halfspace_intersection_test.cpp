@@ -682,6 +682,55 @@ TEST_CASE("halfspace_intersection: an erosion's guess on tiny, huge and far oper
     CHECK(r.polytope->num_faces() == A.num_faces());
   }
 }
+
+// Vertices of high degree (a UV sphere's poles, a cone's apex) are triangulated first and
+// their triangles' vertices tested against the planes nearby, which rejects a guess early
+// where facets vanish near them (the UV sphere's thin facets at the poles) and must keep a
+// right one (a small element; one 2^-40 times A's size, whose opened-up vertices lie within
+// rounding of each other, so exact signs decide): scaled by 2^+-200 and far from the origin,
+// each result the hull's and the exact route's.
+TEST_CASE("halfspace_intersection: an erosion's guess near vertices of high degree") {
+  const morph::Mesh& uv = sample("uvsphere_1600.off");
+  const morph::Mesh snub = morph::test::scaled(sample("snub_dodecahedron.off"), 0.25);
+  std::vector<morph::Point> cone_points{{0, 0, 1}};
+  for (int i = 0; i < 48; ++i) {
+    const double t = 2 * M_PI * i / 48;
+    cone_points.push_back({std::cos(t), std::sin(t), -1});
+  }
+  const morph::Mesh cone = morph::test::convex_hull_mesh(cone_points);
+  const morph::Mesh ball =
+      morph::test::transformed(sample("icosphere_80.off"), morph::test::random_rotation(5));
+  struct Case {
+    const char* what;
+    morph::Mesh A, B;
+    bool vanish;  // facets of A vanish: the guess is rejected
+  };
+  const Case cases[] = {
+      {"uvsphere by a snub dodecahedron", uv, snub, true},
+      {"uvsphere scaled by 2^200", morph::test::scaled(uv, 0x1p200),
+       morph::test::scaled(snub, 0x1p200), true},
+      {"uvsphere scaled by 2^-200", morph::test::scaled(uv, 0x1p-200),
+       morph::test::scaled(snub, 0x1p-200), true},
+      {"uvsphere far from the origin", morph::test::translated(uv, {1e6, -3e5, 7e5}), snub, true},
+      {"uvsphere by a small ball", uv, morph::test::scaled(ball, 1.0 / 64), false},
+      {"uvsphere by a ball 2^-40", uv, morph::test::scaled(ball, 0x1p-40), false},
+      {"cone by a ball 2^-40", cone, morph::test::scaled(ball, 0x1p-40), false},
+      {"cone scaled by 2^200", morph::test::scaled(cone, 0x1p200),
+       morph::test::scaled(ball, 0x1p190), false},
+      {"cone scaled by 2^-200", morph::test::scaled(cone, 0x1p-200),
+       morph::test::scaled(ball, 0x1p-210), false},
+      {"cone far from the origin", morph::test::translated(cone, {1e6, -3e5, 7e5}),
+       morph::test::scaled(ball, 1.0 / 64), false},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(std::string(c.what));
+    const Polytope A = make_operand(c.A, "A");
+    const MaybePolytope r = eroded_three_ways(A, make_operand(c.B, "B"));
+    REQUIRE(r.polytope);
+    CHECK((r.route == HullRoute::expected) == !c.vanish);
+    CHECK((r.polytope->num_faces() < A.num_faces()) == c.vanish);
+  }
+}
 namespace {
 
 /// The exact value of a dyadic ExactN as a rational.
@@ -1092,4 +1141,51 @@ TEST_CASE("halfspace_intersection: openings with exact points on demand are the 
       {morph::test::translated(a, {1e6, -3e5, 7e5}), morph::test::scaled(b, 1.0 / 32)},
   };
   for (const auto& [A, B] : cases) check_opening_routes(make_operand(A, "A"), make_operand(B, "B"));
+}
+
+// A triangle's normal in double-double straight from its double corners (set_normal_dd)
+// against the exact cross product: each component within 2^-101 of its |hi| whenever it is
+// set, on random, nearly degenerate (nearly collinear corners: cancellation in every
+// component), 2^+-200-scaled and far-shifted triangles; set for many of them.
+TEST_CASE("halfspace_intersection: a triangle's double-double normal is within its bound") {
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  int set = 0, total = 0;
+  for (int scale : {0, 200, -200}) {
+    for (double shift : {0.0, 1e6, -3e9}) {
+      for (int kind = 0; kind < 3; ++kind) {
+        for (int trial = 0; trial < 200; ++trial) {
+          const auto point = [&](double s) {
+            return V3<double>{std::ldexp(shift + s * unit(rng), scale),
+                              std::ldexp(shift + s * unit(rng), scale),
+                              std::ldexp(s * unit(rng), scale)};
+          };
+          V3<double> p0 = point(1), p1 = point(1), p2 = point(1);
+          if (kind == 1) {  // nearly collinear: p2 next to the midpoint of p0 p1
+            for (double V3<double>::*c : {&V3<double>::x, &V3<double>::y, &V3<double>::z})
+              p2.*c = std::nextafter(p0.*c / 2 + p1.*c / 2, HUGE_VAL);
+          } else if (kind == 2) {  // a tiny triangle, ulps apart
+            p1 = {std::nextafter(p0.x, HUGE_VAL), p0.y, std::nextafter(p0.z, -HUGE_VAL)};
+            p2 = {p0.x, std::nextafter(p0.y, HUGE_VAL), std::nextafter(p0.z, HUGE_VAL)};
+          }
+          HalfSpace h;
+          h.normal = cross(to_exact_n(p1) - to_exact_n(p0), to_exact_n(p2) - to_exact_n(p0));
+          set_normal_dd(h, p0, p1, p2);
+          ++total;
+          if (!h.has_normal_dd) continue;
+          ++set;
+          const ExactN* exact[3] = {&h.normal.x, &h.normal.y, &h.normal.z};
+          for (int k = 0; k < 3; ++k) {
+            const DD& d = h.normal_dd[k];
+            const Exact diff = Exact(*exact[k]) - Exact(d.hi) - Exact(d.lo);
+            const Exact error = diff < 0 ? -diff : diff;
+            CHECK(error <= Exact(std::abs(d.hi)) * Exact(0x1p-101));
+            CHECK(std::abs(d.lo) <= std::abs(d.hi) * 0x1p-52);
+          }
+        }
+      }
+    }
+  }
+  CHECK(set > 0);
+  MESSAGE("double-double normals set for " << set << " of " << total << " triangles");
 }

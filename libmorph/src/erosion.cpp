@@ -210,6 +210,9 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
         // its corners lie exactly on that plane, and h_A - h_B = <n, p - b> in one dot
         // product; differences of doubles as exact_difference.
         h.normal = triangle_normal(A, f);
+        // Its double-double copy from the doubles (cheaper than from the exact value).
+        set_normal_dd(h, A.points[A.corner(f, 0)], A.points[A.corner(f, 1)],
+                      A.points[A.corner(f, 2)]);
         h.offset = dot(h.normal, exact_difference(A.points[A.corner(f, 0)], B.points[b]));
         on[0] = on[1] = on[2] = 1;
         // Another candidate c attains h_B iff <n, c - b> = 0.
@@ -228,13 +231,19 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
         const auto corner = [&](int k) -> const V3<double>& { return A.points[A.corner(f, k)]; };
         h.normal = cross(exact_difference(corner(2), corner(0)),
                          exact_difference(corner(3), corner(1)));
-        std::array<ExactN, 4> height{ExactN(0), ExactN(0), ExactN(0), ExactN(0)};
-        int top = 0;
-        for (int k = 1; k < 4; ++k) {
-          height[k] = dot(h.normal, exact_difference(corner(k), corner(0)));
-          if (height[k] > height[top]) top = k;
+        // n is orthogonal to both diagonals, so <n, p2 - p0> = 0 and <n, p3 - p1> = 0: the
+        // heights are 0, h, 0, h for h = <n, p1 - p0>, and its sign alone (intervals, exact
+        // when they cannot tell) gives the top corners: 1 and 3 when h > 0, 0 and 2 when
+        // h < 0, all four when the quadrilateral is planar.
+        int sign;
+        {
+          RoundingGuard guard;
+          sign = interval_sign(
+              dot(to_interval_n(h.normal), to_interval(corner(1)) - to_interval(corner(0))));
         }
-        for (int k = 0; k < 4; ++k) on[k] = k == top || height[k] == height[top];
+        if (sign == 2) sign = CGAL::sign(dot(h.normal, exact_difference(corner(1), corner(0))));
+        const int top = sign > 0 ? 1 : 0;
+        for (int k = 0; k < 4; ++k) on[k] = sign == 0 || k % 2 == top;
         h.offset = dot(h.normal, exact_difference(corner(top), B.points[b]));
         for (int c : candidates)
           if (c != b && CGAL::sign(dot(h.normal, exact_difference(B.points[c], B.points[b]))) == 0)

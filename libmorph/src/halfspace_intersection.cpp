@@ -73,6 +73,7 @@ struct Plane {
   ExactN d;
   V3<Interval> ni;
   Interval di;
+  const HalfSpace* source = nullptr;  // its normal's double-double copy, when it has one
 };
 
 std::vector<Plane> planes_of(const std::vector<HalfSpace>& hs) {
@@ -85,6 +86,7 @@ std::vector<Plane> planes_of(const std::vector<HalfSpace>& hs) {
       p.n = q == 1 ? hs[i].normal
                    : V3<ExactN>{hs[i].normal.x * q, hs[i].normal.y * q, hs[i].normal.z * q};
       p.d = hs[i].offset;
+      if (q == 1 && hs[i].has_normal_dd) p.source = &hs[i];
       p.ni = to_interval_n(p.n);
       p.di = to_interval_n(p.d);
     }
@@ -307,11 +309,18 @@ constexpr double kPlaneRelative = 0x1p-100;
 /// the power of two that brings the largest |c[k]|, k in [lead_begin, lead_end), into
 /// [1, 2); false when a value is beyond 2^400 or a non-zero one below 2^-900 after that
 /// (round-to-nearest).
+/// `given`, when not null, holds c[0] .. c[2] already in double-double, each within
+/// kPlaneRelative / 2 of its |hi| (HalfSpace::normal_dd).
 bool precise_scaled(const std::array<const ExactN*, 4>& c, int lead_begin, int lead_end,
-                    std::array<DD, 4>& out) {
+                    std::array<DD, 4>& out, const std::array<DD, 3>* given = nullptr) {
   std::array<DD, 4> v{};
   double largest = 0;
   for (int k = 0; k < 4; ++k) {
+    if (given && k < 3) {
+      v[k] = (*given)[k];
+      if (k >= lead_begin && k < lead_end) largest = std::max(largest, std::abs(v[k].hi));
+      continue;
+    }
     if (CGAL::sign(*c[k]) == CGAL::ZERO) continue;
     double error;
     v[k] = to_dd(*c[k], error);
@@ -340,7 +349,8 @@ struct PrecisePlane {
 };
 PrecisePlane precise_plane(const Plane& plane) {
   PrecisePlane p;
-  p.valid = precise_scaled({&plane.n.x, &plane.n.y, &plane.n.z, &plane.d}, 0, 3, p.c);
+  p.valid = precise_scaled({&plane.n.x, &plane.n.y, &plane.n.z, &plane.d}, 0, 3, p.c,
+                           plane.source ? &plane.source->normal_dd : nullptr);
   return p;
 }
 V3<DD> normal_dd(const PrecisePlane& p) { return {p.c[0], p.c[1], p.c[2]}; }
@@ -1357,6 +1367,39 @@ class IncrementalHull {
     for (const Tri& t : tris_)
       if (t.alive)
         out.across.push_back({index[t.across[0]], index[t.across[1]], index[t.across[2]]});
+    // Each triangle's vertex for the check, as far as the run computed it (the intervals of
+    // its meet, its precise and exact coordinates, its known point); one whose W is not
+    // positive by intervals is left to the check.
+    out.vertex.resize(out.corner.size());
+    out.has_vertex.assign(out.corner.size(), 0);
+    for (std::size_t t = 0; t < tris_.size(); ++t) {
+      const Tri& tri = tris_[t];
+      if (!tri.alive || !(tri.Wi.inf() > 0)) continue;
+      HVertex& v = out.vertex[index[t]];
+      v.planes = tri.c;
+      if (tri.known >= 0) {
+        set_known(known_, tri.known, v);
+      } else {
+        v.Xi = tri.Xi;
+        v.Wi = tri.Wi;
+        v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
+        if (tri.precise >= 0) {
+          const HVertex& q = precise_vertex_[tri.precise];
+          v.px = q.px;
+          v.pw = q.pw;
+          v.ex = q.ex;
+          v.ew = q.ew;
+          v.precise = true;
+        }
+        v.precise_tried = tri.precise != -1;
+        if (tri.exact >= 0) {
+          v.X = exact_[tri.exact].X;
+          v.W = exact_[tri.exact].W;
+          v.has_exact = true;
+        }
+      }
+      out.has_vertex[index[t]] = 1;
+    }
     return Outcome::hull;
   }
 
@@ -1369,6 +1412,7 @@ class IncrementalHull {
     int precise = -1;  // its precise coordinates in precise_vertex_, once tried (-2: none)
     int known = -1;    // the known point it is, if any (KnownPoints)
     int pending = -1;  // first of the planes that see it (linked by next_pending_)
+    int replaced = -1;  // once removed: a new triangle made on one of its horizon edges
     bool alive = true;
   };
   struct ExactVertex {
@@ -1378,17 +1422,26 @@ class IncrementalHull {
 
   const Plane& plane(int i) const { return i < n_ ? planes_[i] : virtual_[i - n_]; }
 
-  int add(int a, int b, int c) {
+  /// Adds triangle (a, b, c) with the cross products of its corners' normals along its edges
+  /// (edge k, corner k to k + 1: ab = n_a x n_b, bc, ca), kept for the triangles made next
+  /// to it (edge_cross_).
+  int add(int a, int b, int c, const V3<Interval>& ab, const V3<Interval>& bc,
+          const V3<Interval>& ca) {
     Tri t;
     t.c = {a, b, c};
     t.across = {-1, -1, -1};
-    const Plane &pa = plane(a), &pb = plane(b), &pc = plane(c);
-    meet(pa.ni, pa.di, pb.ni, pb.di, pc.ni, pc.di, t.Xi, t.Wi);
+    const Plane& pa = plane(a);
+    meet_of_crosses(pa.ni, pa.di, plane(b).di, plane(c).di, bc, ca, ab, t.Xi, t.Wi);
     // Three planes through a known point with independent normals (W > 0) meet there.
     if (!known_.empty() && a < n_ && b < n_ && c < n_ && t.Wi.inf() > 0)
       t.known = known_.common(a, b, c);
     tris_.push_back(t);
+    edge_cross_.push_back({ab, bc, ca});
     return static_cast<int>(tris_.size()) - 1;
+  }
+  int add(int a, int b, int c) {
+    const V3<Interval> &na = plane(a).ni, &nb = plane(b).ni, &nc = plane(c).ni;
+    return add(a, b, c, cross(na, nb), cross(nb, nc), cross(nc, na));
   }
 
   int side_of(int p, int t) {
@@ -1443,6 +1496,8 @@ class IncrementalHull {
   void start() {
     const int n = n_;
     tris_.reserve(8 * static_cast<std::size_t>(n) + 16);
+    edge_cross_.reserve(tris_.capacity());
+    around_cross_.resize(n + 4);
     // Around vertex n + 3 (det of the other three normals > 0 in this order).
     const int t0 = add(n, n + 1, n + 2), t1 = add(n + 1, n, n + 3), t2 = add(n + 2, n + 1, n + 3),
               t3 = add(n, n + 2, n + 3);
@@ -1490,16 +1545,27 @@ class IncrementalHull {
     // One new triangle (u, w, p) per horizon edge u -> w, linked around p.
     created_.clear();
     bool ok = true;
+    // Each new triangle (u, w, p) needs n_u x n_w (the removed triangle's, along its edge
+    // u -> w), n_w x n_p and n_p x n_u: the last computed once per horizon vertex u
+    // (around_cross_), the other the next triangle's negated (negation is exact: the same
+    // intervals as computed afresh). A w that starts no horizon edge fails the insertion below.
+    const V3<Interval>& np = plane(p).ni;
+    for (const auto& [t, k] : horizon_) {
+      const int u = tris_[t].c[k];
+      around_cross_[u] = cross(np, plane(u).ni);
+    }
+    const auto negated = [](const V3<Interval>& v) { return V3<Interval>{-v.x, -v.y, -v.z}; };
     for (const auto& [t, k] : horizon_) {
       const int u = tris_[t].c[k], w = tris_[t].c[(k + 1) % 3];
       const int kept = tris_[t].across[k];
-      const int nt = add(u, w, p);
+      const int nt = add(u, w, p, edge_cross_[t][k], negated(around_cross_[w]), around_cross_[u]);
       tris_[nt].across[0] = kept;
       int j = 0;
       while (j < 3 && tris_[kept].across[j] != t) ++j;
       if (j == 3 || start_at_[u] >= 0) ok = false;
       if (!ok) break;
       tris_[kept].across[j] = nt;
+      tris_[t].replaced = nt;
       start_at_[u] = nt;
       created_.push_back(nt);
     }
@@ -1518,8 +1584,16 @@ class IncrementalHull {
         next = next_pending_[q];
         conflict_[q] = -1;
         if (q == p) continue;
+        // The new triangle made on t's horizon edge first (q saw t, and often sees what
+        // replaced it), then the others in order. Which one q records does not change the
+        // hull: the visible triangles found from any of them are the same.
+        const int near = tris_[t].replaced;
+        if (near >= 0 && side_of(q, near) > 0) {
+          see(q, near);
+          continue;
+        }
         for (int nt : created_) {
-          if (side_of(q, nt) > 0) {
+          if (nt != near && side_of(q, nt) > 0) {
             see(q, nt);
             break;
           }
@@ -1536,6 +1610,8 @@ class IncrementalHull {
   int n_;
   std::array<Plane, 4> virtual_;
   std::vector<Tri> tris_;
+  std::vector<std::array<V3<Interval>, 3>> edge_cross_;  // per triangle: ab, bc, ca (add)
+  std::vector<V3<Interval>> around_cross_;  // per plane: n_p x n_u around the inserted p
   std::deque<ExactVertex> exact_;
   std::deque<HVertex> precise_vertex_;
   std::vector<int> conflict_, next_pending_;  // per real plane
@@ -1631,6 +1707,48 @@ PreciseProbe probe_precise_point(const V3<ExactN>& X, const ExactN& W) {
   return out;
 }
 
+void set_normal_dd(HalfSpace& h, const V3<double>& p0, const V3<double>& p1,
+                   const V3<double>& p2) {
+  CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+  // The edge vectors, each difference exact (two_sum's error term zero, no overflow).
+  V3<double> e1, e2;
+  const auto difference = [](double a, double b, double& out) {
+    const DD s = two_sum(a, -b);
+    out = s.hi;
+    return s.lo == 0 && std::abs(s.hi) <= 0x1p900;
+  };
+  if (!difference(p1.x, p0.x, e1.x) || !difference(p1.y, p0.y, e1.y) ||
+      !difference(p1.z, p0.z, e1.z) || !difference(p2.x, p0.x, e2.x) ||
+      !difference(p2.y, p0.y, e2.y) || !difference(p2.z, p0.z, e2.z))
+    return;
+  // Each component is a b - c d of doubles: both products exact by two_prod (factors below
+  // 2^900, each non-zero product at least 2^-900 in magnitude: no overflow, no underflow), and
+  // a.hi - c.hi exact by two_sum. The rest, s.lo + (a.lo - c.lo), errs by u = 2^-53 of each
+  // of its two rounded operations' results; the last two_sum is exact. So the value is within
+  // u (|t| + |r|) of hi + lo, which must be within 2^-101 of |hi| (else the normal is left
+  // to its exact conversion).
+  const auto component = [](double a, double b, double c, double d, DD& out) {
+    for (double x : {a, b, c, d})
+      if (!(std::abs(x) <= 0x1p900)) return false;
+    const DD p = two_prod(a, b), q = two_prod(c, d);
+    const auto in_range = [](double x, double y, double product) {
+      return x == 0 || y == 0 || (std::abs(product) >= 0x1p-900 && std::abs(product) <= 0x1p990);
+    };
+    if (!in_range(a, b, p.hi) || !in_range(c, d, q.hi)) return false;
+    const DD s = two_sum(p.hi, -q.hi);
+    const double t = p.lo - q.lo, r = s.lo + t;
+    out = two_sum(s.hi, r);
+    const double error = 0x1p-53 * (std::abs(t) + std::abs(r)) * 1.01;
+    return error <= 0x1p-101 * std::abs(out.hi);
+  };
+  std::array<DD, 3> n;
+  if (component(e1.y, e2.z, e1.z, e2.y, n[0]) && component(e1.z, e2.x, e1.x, e2.z, n[1]) &&
+      component(e1.x, e2.y, e1.y, e2.x, n[2])) {
+    h.normal_dd = n;
+    h.has_normal_dd = true;
+  }
+}
+
 HalfSpace make_halfspace(const V3<ExactN>& normal, const Exact& offset, int source) {
   return {normal, integer_n(offset.numerator()), integer_n(offset.denominator()), source};
 }
@@ -1660,6 +1778,10 @@ struct PolygonScratch {
 /// Flips per corner after which a polygon's triangulation gives up: Lawson's flips may
 /// take O(k^2) on a vertex of A of high degree, and the hull is then the cheaper route.
 constexpr int kFlipsPerCorner = 4;
+
+/// Polygons of more planes than this are triangulated first, and tested against the planes
+/// nearby (expected_surface).
+constexpr int kLargePolygon = 8;
 
 /// Triangulates the polygon of planes p[0 .. k) (counter-clockwise seen from outside) so
 /// that it is locally convex, as the dual hull is: Lawson flips from a fan. The diagonal
@@ -1791,15 +1913,72 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const PrecisePlan
     s.has_vertex.assign(nt, 0);
   }
   std::atomic<bool> ok = true;
-  parallel_chunks(nv, 64, [&](int begin, int end) {
+  const auto triangulate = [&](int v, PolygonScratch& scratch) {
+    if (!triangulate_polygon(planes, precise, known, &expected.facets[expected.begin[v]],
+                             expected.begin[v + 1] - expected.begin[v], expected.split,
+                             &s.corner[first[v]], expected.split ? &s.vertex[first[v]] : nullptr,
+                             expected.split ? &s.has_vertex[first[v]] : nullptr, scratch))
+      ok = false;
+  };
+  // Polygons of many planes first, each with a test that rejects a doomed guess early: where
+  // facets of A vanish (the thin facets around the pole of a UV sphere), a vertex of such a
+  // polygon's triangles is cut off by a plane of a polygon nearby. The planes of the polygons
+  // that share a plane with it are tested at its triangles' vertices; one that cuts a vertex
+  // off (side > 0, exactly) proves the guess wrong (a right one has every triangle's vertex
+  // a vertex of the intersection, inside every half-space), and the hull is computed without
+  // triangulating the rest. Each polygon's triangles do not depend on the order.
+  const auto size = [&](int v) { return expected.begin[v + 1] - expected.begin[v]; };
+  std::vector<int> large_polygons;
+  if (expected.split)
+    for (int v = 0; v < nv; ++v)
+      if (size(v) > kLargePolygon) large_polygons.push_back(v);
+  if (!large_polygons.empty()) {
+    // The polygons through each plane (a counting sort of the expected facets).
+    const int n = static_cast<int>(planes.size());
+    std::vector<int> through_begin(n + 1, 0), through(expected.facets.size());
+    for (int i : expected.facets) ++through_begin[i + 1];
+    std::partial_sum(through_begin.begin(), through_begin.end(), through_begin.begin());
+    {
+      std::vector<int> next(through_begin.begin(), through_begin.end() - 1);
+      for (int v = 0; v < nv; ++v)
+        for (int j = expected.begin[v]; j < expected.begin[v + 1]; ++j)
+          through[next[expected.facets[j]]++] = v;
+    }
+    parallel_chunks(static_cast<int>(large_polygons.size()), 1, [&](int begin, int end) {
+      RoundingGuard guard;
+      PolygonScratch scratch;
+      std::vector<int> nearby;
+      for (int j = begin; j < end && ok; ++j) {
+        const int v = large_polygons[j];
+        triangulate(v, scratch);
+        if (!ok) break;
+        const int* p = &expected.facets[expected.begin[v]];
+        nearby.clear();
+        for (int i = 0; i < size(v); ++i)
+          for (int w = through_begin[p[i]]; w < through_begin[p[i] + 1]; ++w)
+            for (int c = expected.begin[through[w]]; c < expected.begin[through[w] + 1]; ++c)
+              if (std::find(p, p + size(v), expected.facets[c]) == p + size(v))
+                nearby.push_back(expected.facets[c]);
+        std::sort(nearby.begin(), nearby.end());
+        nearby.erase(std::unique(nearby.begin(), nearby.end()), nearby.end());
+        for (int t = first[v]; t < first[v + 1] && ok; ++t) {
+          HVertex& x = s.vertex[t];
+          // (W > 0 for the sign below: a known point, or positive by intervals.)
+          if (!s.has_vertex[t] || (x.known < 0 && !(x.Wi.inf() > 0))) continue;
+          for (int i : nearby)
+            if (!known_through(known, i, x) && side(planes, precise, i, x) > 0) {
+              ok = false;
+              break;
+            }
+        }
+      }
+    });
+  }
+  parallel_chunks(ok ? nv : 0, 64, [&](int begin, int end) {
     RoundingGuard guard;
     PolygonScratch scratch;
     for (int v = begin; v < end && ok; ++v)
-      if (!triangulate_polygon(planes, precise, known, &expected.facets[expected.begin[v]],
-                               expected.begin[v + 1] - expected.begin[v], expected.split,
-                               &s.corner[first[v]], expected.split ? &s.vertex[first[v]] : nullptr,
-                               expected.split ? &s.has_vertex[first[v]] : nullptr, scratch))
-        ok = false;
+      if (large_polygons.empty() || size(v) <= kLargePolygon) triangulate(v, scratch);
   });
   if (!ok) return {};
   // Directed edges 3 t + k (corner k to k + 1 of triangle t) listed by their first plane

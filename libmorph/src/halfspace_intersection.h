@@ -25,7 +25,17 @@ struct HalfSpace {
   ExactN denominator = ExactN(1);  // positive
   int source = -1;                 // erosion: the facet of A (its label)
   int element = -1;                // erosion: the vertex of B that moved it inwards (its label)
+  // Optional (set_normal_dd): the normal's components in double-double, each within 2^-101 of
+  // its |hi| (round-to-nearest), so the precise stage need not convert them from `normal`.
+  std::array<DD, 3> normal_dd{};
+  bool has_normal_dd = false;
 };
+
+/// Sets h.normal_dd from h.normal = (p1 - p0) x (p2 - p0) for a triangle of double points
+/// (its Newell normal), when the differences are exact in doubles and the products and the
+/// bound allow; leaves h unchanged otherwise.
+void set_normal_dd(HalfSpace& h, const V3<double>& p0, const V3<double>& p1,
+                   const V3<double>& p2);
 
 /// The half-space <normal, x> <= offset for any rational offset.
 HalfSpace make_halfspace(const V3<ExactN>& normal, const Exact& offset, int source);
