@@ -482,9 +482,17 @@ EOF
 
   sigint.single)
     # A single-file app interrupted while computing exits 130 at once and writes nothing.
-    "$MESH_DILATE" "$cube" --se sphere:r=0.1,level=7 -o out.off --threads 1 >out.txt 2>err.txt &
+    # --verbose notes the element once it is built, after the handler is installed and before
+    # the sum (about 0.3 s on one thread): the signal is sent then, not after a fixed sleep that
+    # a loaded machine can spend still loading the program (the default action would kill it
+    # without the message).
+    "$MESH_DILATE" "$cube" --se sphere:r=0.1,level=7 -o out.off --threads 1 --verbose \
+      >out.txt 2>err.txt &
     pid=$!
-    sleep 0.3
+    for _ in $(seq 1 200); do  # at most 10 s
+      grep -q "structuring element" err.txt 2>/dev/null && break
+      sleep 0.05
+    done
     kill -INT "$pid"
     wait "$pid"
     code=$?
