@@ -204,6 +204,13 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
       HalfSpace& h = hs[f];
       h.source = A.face_source[f];
       h.element = B.vertex_source[b];
+      // For a normal of double differences and an element of double points: another
+      // candidate c attains h_B iff <n, c - b> = 0.
+      const auto add_others_on_plane = [&](const V3<ExactN>& normal) {
+        for (int c : candidates)
+          if (c != b && CGAL::sign(dot(normal, exact_difference(B.points[c], B.points[b]))) == 0)
+            others[f].push_back(c);
+      };
       if (A.degree(f) == 3 && A.given_normals.empty() && B.exact_points.empty()) {
         // A triangle of double points (A's are then all doubles) and an element of double
         // points: its Newell normal is (q - p) x (r - p), the same value in fewer products,
@@ -215,10 +222,7 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
                       A.points[A.corner(f, 2)]);
         h.offset = dot(h.normal, exact_difference(A.points[A.corner(f, 0)], B.points[b]));
         on[0] = on[1] = on[2] = 1;
-        // Another candidate c attains h_B iff <n, c - b> = 0.
-        for (int c : candidates)
-          if (c != b && CGAL::sign(dot(h.normal, exact_difference(B.points[c], B.points[b]))) == 0)
-            others[f].push_back(c);
+        add_others_on_plane(h.normal);
         continue;
       }
       if (A.degree(f) == 4 && A.given_normals.empty() && A.exact_points.empty() &&
@@ -245,9 +249,7 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
         const int top = sign > 0 ? 1 : 0;
         for (int k = 0; k < 4; ++k) on[k] = sign == 0 || k % 2 == top;
         h.offset = dot(h.normal, exact_difference(corner(top), B.points[b]));
-        for (int c : candidates)
-          if (c != b && CGAL::sign(dot(h.normal, exact_difference(B.points[c], B.points[b]))) == 0)
-            others[f].push_back(c);
+        add_others_on_plane(h.normal);
         continue;
       }
       const V3<ExactN> n =

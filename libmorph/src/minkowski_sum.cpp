@@ -316,7 +316,6 @@ std::vector<int> walk_starts(const Polytope& X, const Polytope& Y,
           starts[f] = Y.corner(nearest, k);
         }
       }
-      if (starts[f] < 0) starts[f] = Y.corner(nearest, 0);
     }
   });
   return starts;

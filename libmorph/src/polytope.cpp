@@ -1192,14 +1192,9 @@ Polytope finish_from_halfedges(Polytope& p, std::vector<int> mesh_edge, const Me
 // allow: waking a worker costs more than the shorter of the two halves.
 constexpr int kParallelOperandFaces = 1000;
 
-void copy_points(Polytope& p, const Mesh& mesh) {
-  p.points.resize(mesh.n_vertices());
-  const Point* q = mesh.points();
-  for (int v = 0; v < p.num_vertices(); ++v) p.points[v] = {q[v][0], q[v][1], q[v][2]};
-}
-
-/// copy_points, and whether the mesh is readable() (every coordinate finite), in one pass.
-bool copy_readable_points(Polytope& p, const Mesh& mesh) {
+/// The mesh's points into p, and whether the mesh is readable() (every coordinate finite),
+/// in one pass.
+bool copy_points(Polytope& p, const Mesh& mesh) {
   p.points.resize(mesh.n_vertices());
   const Point* q = mesh.points();
   bool finite = true;
@@ -1226,7 +1221,7 @@ std::optional<Polytope> checked_polytope(const Mesh& mesh, const char* name) {
       return std::nullopt;
   }
   Polytope p;
-  if (!copy_readable_points(p, mesh)) return std::nullopt;
+  if (!copy_points(p, mesh)) return std::nullopt;
   OperandTopology topology;
   std::vector<int> mesh_edge;
   try {
@@ -1272,7 +1267,7 @@ std::optional<Polytope> checked_polytope(const Mesh& mesh, const char* name) {
 Polytope make_polytope(const Mesh& mesh, const char* name, FaceOrder order) {
   if (has_deleted_elements(mesh)) return make_polytope_from_cycles(mesh, name, order);
   Polytope p;
-  copy_points(p, mesh);
+  copy_points(p, mesh);  // finiteness: make_operand reads the mesh only once it is readable()
   std::vector<int> mesh_edge = connectivity_from_halfedges(p, mesh, order);
   return finish_from_halfedges(p, std::move(mesh_edge), mesh, name, order);
 }
