@@ -1189,7 +1189,7 @@ Polytope finish_from_halfedges(Polytope& p, std::vector<int> mesh_edge, const Me
 }
 
 // Below this many facets, checked_polytope checks and builds in sequence even when threads
-// allow: waking a worker costs more than the shorter of the two halves.
+// allow: waking a worker costs more than the check.
 constexpr int kParallelOperandFaces = 1000;
 
 /// The mesh's points into p, and whether the mesh is readable() (every coordinate finite),
@@ -1209,7 +1209,8 @@ bool copy_points(Polytope& p, const Mesh& mesh) {
 /// make_operand(mesh, name) in one pass for a mesh that is an operand as it is (the usual
 /// case): the halfedge walks that build the polytope also find whether check_operand's
 /// topological checks pass, and its geometric checks then run on the polytope's facet cycles
-/// (geometry_passes), so the mesh's connectivity is read once. Returns nothing when the check
+/// (geometry_passes), so the mesh's connectivity is read once (with threads to spare, a large
+/// mesh's check reads its own cycles instead, beside the walks). Returns nothing when the check
 /// would not pass the mesh as it is (an error, an inverted mesh, a deleted element) or the
 /// walks meet anything unusual: make_operand then checks and builds as before, for the same
 /// messages. The polytope is make_polytope(mesh, name)'s, built by the same code.
@@ -1224,25 +1225,21 @@ std::optional<Polytope> checked_polytope(const Mesh& mesh, const char* name) {
   if (!copy_points(p, mesh)) return std::nullopt;
   OperandTopology topology;
   std::vector<int> mesh_edge;
-  try {
-    mesh_edge = connectivity_from_halfedges(p, mesh, FaceOrder::as_given, &topology);
-  } catch (const error&) {  // a broken face cycle or fan: the check names it
-    return std::nullopt;
-  }
-  if (!topology.passes) return std::nullopt;
-  // The geometric checks and the rest of the build both only read the facet cycles: beside
-  // each other when threads allow, the build first in the order given to run_both, and with
-  // one thread the check first. The check's verdict decides, as in make_operand.
+  // The halfedge walks; false when they meet a broken face cycle or fan (the check names it).
+  const auto walk = [&] {
+    try {
+      mesh_edge = connectivity_from_halfedges(p, mesh, FaceOrder::as_given, &topology);
+    } catch (const error&) {
+      return false;
+    }
+    return true;
+  };
+  // The geometric checks and the rest of the build both only read the facet cycles. The
+  // check's verdict decides, as in make_operand.
   std::atomic<bool> rejected{false};
-  bool passes = false;
+  bool passes = false, walked = false;
   std::optional<Polytope> built;
   std::exception_ptr build_error;
-  // Taken before the build may move the arrays into its result (their buffers stay).
-  const FaceCycleView cycles{p.face_begin.data(), p.corner_vertex.data(), topology.across.data()};
-  const auto check = [&] {
-    passes = geometry_passes(mesh, cycles);
-    rejected = !passes;
-  };
   const auto build = [&] {
     if (rejected) return;
     try {
@@ -1251,13 +1248,33 @@ std::optional<Polytope> checked_polytope(const Mesh& mesh, const char* name) {
       build_error = std::current_exception();
     }
   };
-  if (p.num_faces() >= kParallelOperandFaces && tbb::this_task_arena::max_concurrency() > 1) {
-    run_both(build, check);
+  if (static_cast<int>(mesh.n_faces()) >= kParallelOperandFaces &&
+      tbb::this_task_arena::max_concurrency() > 1) {
+    // Beside each other from the start: the check on face cycles of its own (the same as the
+    // walks', whenever the topology passes), the walks then the build on this thread. The
+    // check is the first function, the one another thread takes: two operands made side by
+    // side (make_operands) end sooner when the thread done with the smaller one takes the
+    // larger one's check, instead of waiting for its walks.
+    run_both(
+        [&] {
+          passes = geometry_passes(mesh);
+          rejected = !passes;
+        },
+        [&] {
+          walked = walk() && topology.passes;
+          if (walked) build();
+        });
   } else {
-    check();
+    // In sequence, the check on the walks' cycles (read once), before the build.
+    walked = walk() && topology.passes;
+    if (!walked) return std::nullopt;
+    const FaceCycleView cycles{p.face_begin.data(), p.corner_vertex.data(),
+                               topology.across.data()};
+    passes = geometry_passes(mesh, cycles);
+    rejected = !passes;
     build();
   }
-  if (!passes) return std::nullopt;
+  if (!walked || !passes) return std::nullopt;
   if (build_error) std::rethrow_exception(build_error);
   return built;
 }

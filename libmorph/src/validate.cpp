@@ -460,6 +460,109 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, double 
   return true;
 }
 
+// reflex_across() with the caller's height function, for quad_passes: a triangle's or a
+// quadrilateral's corners off the edge found without a loop. A quadrilateral g holds the edge
+// as to -> from (the opposite halfedge); its corners off the edge are the two after `from`.
+// When g repeats a vertex (so that these could differ from the loop's), g fails its own check
+// in nondegenerate(), and that failure is the verdict whatever the reflex flag says.
+template <class Height>
+bool reflex_across_small(const MeshView& m, const FaceCycles& cycles, const Height& height, int g,
+                         int from, int to, double tolerance) {
+  const int gb = cycles.begin[g];
+  const int* corners = cycles.vertex + gb;
+  const int n = cycles.begin[g + 1] - gb;
+  if (n == 3) {
+    const int v = corners[0] != from && corners[0] != to   ? corners[0]
+                  : corners[1] != from && corners[1] != to ? corners[1]
+                                                           : corners[2];
+    return !(height(m.points[v]) <= tolerance);
+  }
+  if (n == 4) {
+    const int j = corners[0] == to ? 0 : corners[1] == to ? 1 : corners[2] == to ? 2 : 3;
+    if (corners[(j + 1) & 3] == from && corners[j] == to)
+      return !(height(m.points[corners[(j + 2) & 3]]) <= tolerance) |
+             !(height(m.points[corners[(j + 3) & 3]]) <= tolerance);
+  }
+  for (int k = 0; k < n; ++k) {
+    const int v = corners[k];
+    if (v == from || v == to) continue;
+    if (!(height(m.points[v]) <= tolerance)) return true;
+  }
+  return false;
+}
+
+// A quadrilateral's share of nondegenerate() (UV spheres and boxes are made of them), as
+// triangle_passes: the same operations in the same order as newell_plane(), height(),
+// FanVolumes::add_face() and reflex_across(), written out, so every value and verdict is
+// the general path's. Returns false, having changed nothing, when the quadrilateral repeats
+// a vertex or a position or has zero area: the general path then names the problem (a
+// repeated vertex does not zero a quadrilateral's normal, so both are tested here).
+bool quad_passes(const MeshView& m, const FaceCycles& cycles, int f, double tolerance,
+                 double zero_area, bool convexity, const Point& centre, FanVolumes& volumes,
+                 int& non_planar_face, bool& any_reflex) {
+  const int b = cycles.begin[f];
+  const int* ids = cycles.vertex + b;
+  const int i0 = ids[0], i1 = ids[1], i2 = ids[2], i3 = ids[3];
+  if (i0 == i1 || i0 == i2 || i0 == i3 || i1 == i2 || i1 == i3 || i2 == i3) return false;
+  const Point &p0 = m.points[i0], &p1 = m.points[i1], &p2 = m.points[i2], &p3 = m.points[i3];
+  if (p0 == p1 || p0 == p2 || p0 == p3 || p1 == p2 || p1 == p3 || p2 == p3) return false;
+  // newell_plane(): the centroid summed from zero and scaled by 1.0 / 4 (exactly 0.25).
+  const double cx = ((((0.0 + p0[0]) + p1[0]) + p2[0]) + p3[0]) * (1.0 / 4);
+  const double cy = ((((0.0 + p0[1]) + p1[1]) + p2[1]) + p3[1]) * (1.0 / 4);
+  const double cz = ((((0.0 + p0[2]) + p1[2]) + p2[2]) + p3[2]) * (1.0 / 4);
+  // The corners relative to the centroid, and cross(u, v) summed over the edges a-b, b-q,
+  // q-r, r-a from zero (component i: u[j] v[l] - u[l] v[j], (j, l) = (i + 1, i + 2) mod 3).
+  const double ax = p0[0] - cx, ay = p0[1] - cy, az = p0[2] - cz;
+  const double bx = p1[0] - cx, by = p1[1] - cy, bz = p1[2] - cz;
+  const double qx = p2[0] - cx, qy = p2[1] - cy, qz = p2[2] - cz;
+  const double rx = p3[0] - cx, ry = p3[1] - cy, rz = p3[2] - cz;
+  double nx = (((0.0 + (ay * bz - az * by)) + (by * qz - bz * qy)) + (qy * rz - qz * ry)) +
+              (ry * az - rz * ay);
+  double ny = (((0.0 + (az * bx - ax * bz)) + (bz * qx - bx * qz)) + (qz * rx - qx * rz)) +
+              (rz * ax - rx * az);
+  double nz = (((0.0 + (ax * by - ay * bx)) + (bx * qy - by * qx)) + (qx * ry - qy * rx)) +
+              (rx * ay - ry * ax);
+  const double length = std::sqrt((nx * nx + ny * ny) + nz * nz);
+  if (!(length > zero_area)) return false;
+  const double inverse = 1.0 / length;
+  nx *= inverse;
+  ny *= inverse;
+  nz *= inverse;
+  {
+    // FanVolumes::add_face(): the fan from the last corner, tetrahedra (r, a, b), (r, b, q).
+    const Point& o = centre;
+    const double u[3] = {p3[0] - o[0], p3[1] - o[1], p3[2] - o[2]};
+    const double v[3] = {p0[0] - o[0], p0[1] - o[1], p0[2] - o[2]};
+    const double w[3] = {p1[0] - o[0], p1[1] - o[1], p1[2] - o[2]};
+    const double t[3] = {p2[0] - o[0], p2[1] - o[1], p2[2] - o[2]};
+    const double first = (u[0] * (v[1] * w[2] - v[2] * w[1]) + u[1] * (v[2] * w[0] - v[0] * w[2])) +
+                         u[2] * (v[0] * w[1] - v[1] * w[0]);
+    volumes.total += first;
+    volumes.absolute += std::abs(first);
+    const double second = (u[0] * (w[1] * t[2] - w[2] * t[1]) + u[1] * (w[2] * t[0] - w[0] * t[2])) +
+                          u[2] * (w[0] * t[1] - w[1] * t[0]);
+    volumes.total += second;
+    volumes.absolute += std::abs(second);
+  }
+  // height(plane, p): dot(p - centroid, normal), summed in OpenMesh's order.
+  const auto height = [&](const Point& p) {
+    return (p[0] - cx) * nx + (p[1] - cy) * ny + (p[2] - cz) * nz;
+  };
+  if (non_planar_face < 0 &&
+      !(std::abs(height(p0)) <= tolerance && std::abs(height(p1)) <= tolerance &&
+        std::abs(height(p2)) <= tolerance && std::abs(height(p3)) <= tolerance))
+    non_planar_face = f;
+  if (!convexity || any_reflex) return true;
+  // Across the edge that ends at each corner (all four: the flag is the same, and the order
+  // of the general path's early exit only decides where it stops).
+  const int* across = cycles.across + b;
+  any_reflex = reflex_across_small(m, cycles, height, across[0], i3, i0, tolerance) |
+               reflex_across_small(m, cycles, height, across[1], i0, i1, tolerance) |
+               reflex_across_small(m, cycles, height, across[2], i1, i2, tolerance) |
+               reflex_across_small(m, cycles, height, across[3], i2, i3, tolerance);
+  return true;
+}
+
 // Fills `geometry` for the later checks when the mesh passes; planarity is judged with
 // `relative_tolerance` times the bounding-box diagonal. With `convexity` (only for a closed
 // mesh), also whether any edge may be reflex, with each face's plane while it is at hand.
@@ -492,6 +595,9 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
     const int n = geometry.cycles.degree(f);
     if (n == 3 && triangle_passes(m, geometry.cycles, f, tolerance, zero_area, convexity, centre,
                                   volumes, non_planar_face, reflex))
+      continue;
+    if (n == 4 && quad_passes(m, geometry.cycles, f, tolerance, zero_area, convexity, centre,
+                              volumes, non_planar_face, reflex))
       continue;
     const int* ids = geometry.cycles.corners(f);
     const auto face = [&] { return "face " + std::to_string(f); };
@@ -664,6 +770,20 @@ std::optional<PreparedMesh> check_operand(const Mesh& mesh, std::string_view nam
   return prepared;
 }
 
+namespace {
+
+// geometry_passes() once `geometry` holds the face cycles.
+bool geometry_of_cycles_passes(const MeshView& m, Geometry& geometry, double planarity_tolerance) {
+  if (nondegenerate(m, planarity_tolerance, geometry, true, true).verdict != Verdict::ok)
+    return false;
+  if (outward(geometry.volumes).verdict != Verdict::ok) return false;
+  // A reflex flag means planar_and_convex() finds a reflex edge (the same test on the same
+  // face, edge and vertex): no need to look for it.
+  return geometry.non_planar_face < 0 && !geometry.reflex;
+}
+
+}  // namespace
+
 bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles, double planarity_tolerance) {
   // convex_polyhedron() after closed_manifold(), on the caller's cycles: the same checks on
   // the same values, without building the messages of a failure.
@@ -672,12 +792,24 @@ bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles, double plana
   geometry.cycles.begin = cycles.begin;
   geometry.cycles.vertex = cycles.vertex;
   geometry.cycles.across = cycles.across;
-  if (nondegenerate(m, planarity_tolerance, geometry, true, true).verdict != Verdict::ok)
+  return geometry_of_cycles_passes(m, geometry, planarity_tolerance);
+}
+
+bool geometry_passes(const Mesh& mesh, double planarity_tolerance) {
+  // The same on check_operand's own face cycles, read here; safe on any mesh the caller
+  // describes (the geometric checks follow only links to faces).
+  const MeshView m(mesh, true);
+  Geometry geometry;
+  try {
+    geometry.cycles = face_cycles(m);
+  } catch (const error&) {  // a face that is not a closed cycle
     return false;
-  if (outward(geometry.volumes).verdict != Verdict::ok) return false;
-  // A reflex flag means planar_and_convex() finds a reflex edge (the same test on the same
-  // face, edge and vertex): no need to look for it.
-  return geometry.non_planar_face < 0 && !geometry.reflex;
+  }
+  const int corners = geometry.cycles.begin[m.n_faces];
+  if (std::any_of(geometry.cycles.across, geometry.cycles.across + corners,
+                  [](int g) { return g < 0; }))
+    return false;  // an edge with one face: the mesh is open
+  return geometry_of_cycles_passes(m, geometry, planarity_tolerance);
 }
 
 }  // namespace detail

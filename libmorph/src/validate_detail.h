@@ -77,4 +77,11 @@ struct FaceCycleView {
 bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles,
                      double planarity_tolerance = kPlanarityTolerance);
 
+/// geometry_passes(mesh, cycles) on the face cycles read here from the mesh (check_operand's),
+/// for a caller that checks beside the halfedge walks that would give them: the same verdict
+/// whenever the mesh passes check_operand's topological checks. Only for a mesh without deleted
+/// elements, with every coordinate finite; any other may be passed (a face that is not a
+/// closed cycle or an open edge gives false), the verdict then being meaningless.
+bool geometry_passes(const Mesh& mesh, double planarity_tolerance = kPlanarityTolerance);
+
 }  // namespace morph::detail
