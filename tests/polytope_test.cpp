@@ -626,3 +626,59 @@ TEST_CASE("polytope: every turn through three triangles of an operand is strictl
     check_triangle_turns(morph::test::random_sphere_polytope(200, seed),
                          "sphere " + std::to_string(seed));
 }
+
+TEST_CASE("polytope: make_operands gives the same operands and errors with one thread or two") {
+  // With two threads a large operand's check runs beside its halfedge walks (on face cycles
+  // of its own), and the thread done with the smaller operand takes it: the polytopes, and the
+  // error (A's when both are bad), must be those of make_operand(A) then make_operand(B).
+  const auto sample = [](const char* name) {
+    return morph::read_mesh(std::string(MORPH_SAMPLES_DIR) + "/" + name);
+  };
+  const Mesh small = sample("icosphere_320.off"), large = sample("icosphere_1280.off");
+  const Mesh uv = sample("uvsphere_1600.off");
+  REQUIRE(large.n_faces() >= 1000);
+  Mesh dented = large, bent = uv;
+  dented.set_point(Mesh::VertexHandle(0), large.point(Mesh::VertexHandle(0)) * 0.9);
+  bent.set_point(Mesh::VertexHandle(5), uv.point(Mesh::VertexHandle(5)) * (1 + 1e-6));
+  std::vector<std::vector<int>> faces;
+  for (auto f : large.faces()) {
+    std::vector<int> cycle;
+    for (auto v : f.vertices()) cycle.push_back(v.idx());
+    faces.push_back(cycle);
+  }
+  const std::vector<std::vector<int>> holed(faces.begin() + 1, faces.end());
+  const Mesh open = morph::test::mesh_from_polygons(morph::test::positions(large), holed);
+  const Mesh inside_out = inverted(large);
+  const std::vector<std::pair<const Mesh*, const Mesh*>> pairs = {
+      {&small, &large},   {&uv, &large},          {&large, &uv},   {&small, &dented},
+      {&dented, &bent},   {&bent, &small},        {&open, &large}, {&small, &open},
+      {&uv, &inside_out}, {&inside_out, &dented}, {&dented, &open}};
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    CAPTURE(i);
+    const Mesh &A = *pairs[i].first, &B = *pairs[i].second;
+    std::string expected;
+    Polytope a, b;
+    try {
+      a = morph::detail::make_operand(A, "A");
+      b = morph::detail::make_operand(B, "B");
+    } catch (const std::exception& error) {
+      expected = error.what();
+    }
+    for (int threads : {1, 2}) {
+      CAPTURE(threads);
+      tbb::task_arena arena(threads);
+      arena.execute([&] {
+        for (int repeat = 0; repeat < 3; ++repeat) {  // the threads' timing varies
+          try {
+            const morph::detail::Operands op = morph::detail::make_operands(A, B);
+            CHECK(expected == "");
+            CHECK(difference(op.a, a) == "");
+            CHECK(difference(op.b, b) == "");
+          } catch (const std::exception& error) {
+            CHECK(std::string(error.what()) == expected);
+          }
+        }
+      });
+    }
+  }
+}

@@ -6,10 +6,17 @@
 #include <morph/structuring_element.h>
 #include <morph/validate.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <regex>
+#include <set>
 #include <string>
 #include <vector>
+
+#include "../libmorph/src/validate_detail.h"
+#include "support/polytopes.h"
 
 namespace {
 
@@ -374,5 +381,226 @@ TEST_CASE("validate: triangle faces keep the general path's verdicts and message
       inverted.add_face(loop);
     }
     CHECK(problem(inverted) == "the faces are oriented inwards (signed volume -4 < 0)");
+  }
+}
+
+namespace {
+
+// Quadrilaterals take a shortcut through the geometric checks as triangles do (validate.cpp,
+// quad_passes). Each mesh here is checked with and without the shortcuts (the general path
+// alone): same message (or none) to the last digit, and geometry_passes, which make_operand
+// uses (on the mesh's own face cycles when it checks beside the build), agrees.
+std::string check_quad_paths(const Mesh& mesh, const std::string& what,
+                             double tolerance = morph::kPlanarityTolerance) {
+  CAPTURE(what);
+  CAPTURE(tolerance);
+  const std::string fast = morph::detail::convex_polyhedron_problem(mesh, tolerance, true);
+  CHECK(fast == morph::detail::convex_polyhedron_problem(mesh, tolerance, false));
+  morph::ValidationOptions options;
+  options.planarity_tolerance = tolerance;
+  CHECK(morph::check_convex_polyhedron(mesh, options).problem == fast);
+  CHECK(morph::detail::geometry_passes(mesh, tolerance) == fast.empty());
+  return fast;
+}
+
+// check_quad_paths on the mesh as given, scaled by 2^200 and 2^-200 (exactly), and shifted far
+// from the origin (where the same shape rounds to other heights).
+std::string check_quad_variants(const Mesh& mesh, const std::string& what,
+                                double tolerance = morph::kPlanarityTolerance) {
+  const std::string problem = check_quad_paths(mesh, what, tolerance);
+  check_quad_paths(morph::test::scaled(mesh, 0x1p200), what + ", 2^200", tolerance);
+  check_quad_paths(morph::test::scaled(mesh, 0x1p-200), what + ", 2^-200", tolerance);
+  check_quad_paths(morph::test::translated(mesh, Point(1e6, -3e5, 2e6)), what + ", shifted",
+                   tolerance);
+  check_quad_paths(morph::test::translated(mesh, Point(0x1p40, 0x1p41, -0x1p40)), what + ", far",
+                   tolerance);
+  return problem;
+}
+
+// The smallest tolerance at which the general path passes `mesh` (which passes at 1e-3), found
+// by bisection on the bit patterns of the doubles (passing is monotone in the tolerance); 0
+// when it passes at 0. Checking both paths at it and at the double below puts the binding
+// height (the largest that some face's planarity or convexity test compares) at the edge of
+// its test, where one rounding differently would change the verdict.
+double boundary(const Mesh& mesh) {
+  const auto passes = [&](std::uint64_t bits) {
+    double tolerance;
+    std::memcpy(&tolerance, &bits, sizeof tolerance);
+    return morph::detail::convex_polyhedron_problem(mesh, tolerance, false).empty();
+  };
+  std::uint64_t lo = 0, hi;  // the bit patterns of positive doubles order as the values
+  const double top = 1e-3;
+  std::memcpy(&hi, &top, sizeof hi);
+  REQUIRE(passes(hi));
+  if (passes(lo)) return 0;
+  while (hi - lo > 1) {
+    const std::uint64_t mid = lo + (hi - lo) / 2;
+    (passes(mid) ? hi : lo) = mid;
+  }
+  double tolerance;
+  std::memcpy(&tolerance, &hi, sizeof tolerance);
+  return tolerance;
+}
+
+// check_quad_paths at the boundary of `mesh` and just below it.
+void check_at_boundary(const Mesh& mesh, const std::string& what) {
+  const double t = boundary(mesh);
+  CHECK(check_quad_paths(mesh, what + " at its boundary", t) == "");
+  if (t > 0)
+    CHECK(check_quad_paths(mesh, what + " below its boundary", std::nextafter(t, 0.0)) != "");
+}
+
+// The mesh with every vertex moved by up to `amount` times its distance from the origin in
+// each coordinate (a deterministic pseudo-random pattern).
+Mesh jittered(const Mesh& mesh, double amount, std::uint64_t seed) {
+  Mesh out = mesh;
+  std::uint64_t state = seed * 0x9E3779B97F4A7C15ull + 1;
+  const auto next = [&] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<double>(state >> 11) * 0x1p-53 * 2 - 1;  // in [-1, 1)
+  };
+  for (auto v : out.vertices()) {
+    const Point p = out.point(v);
+    const double r = p.norm() * amount;
+    out.set_point(v, p + Point(next() * r, next() * r, next() * r));
+  }
+  return out;
+}
+
+// A house: a box under a roof of two quads meeting at a ridge of height h (convex above 1,
+// flat at 1, reflex below), with pentagonal gables. The ridge is off centre (x = 0.9) and the
+// back 1.8 wide rather than 2, so that one corner (vertex 5, the farthest from the ridge) has
+// the largest height above the other roof quad's plane: its test alone binds. The roof's quads
+// start at corner `left` and `right` of their cycles (so that the ridge ends each in turn).
+Mesh house(double h, int left = 0, int right = 0) {
+  const std::vector<Point> points = {{0, 0, 0},
+                                     {2, 0, 0},
+                                     {1.8, 2, 0},
+                                     {0, 2, 0},
+                                     {0, 0, 1},
+                                     {2, 0, 1},
+                                     {1.8, 2, h + (1 - h) * (0.9 / 1.1)},
+                                     {0, 2, 1},
+                                     {0.9, 0, h},
+                                     {0.9, 2, h}};
+  std::vector<int> roof_left = {4, 8, 9, 7}, roof_right = {8, 5, 6, 9};
+  std::rotate(roof_left.begin(), roof_left.begin() + left, roof_left.end());
+  std::rotate(roof_right.begin(), roof_right.begin() + right, roof_right.end());
+  return mesh_of(points, {{0, 3, 2, 1},
+                          {0, 1, 5, 8, 4},
+                          {2, 3, 7, 9, 6},
+                          {0, 4, 7, 3},
+                          {1, 2, 6, 5},
+                          roof_left,
+                          roof_right});
+}
+
+}  // namespace
+
+TEST_CASE("validate: quadrilaterals keep the general path's verdicts and messages") {
+  SUBCASE("a UV sphere's nearly planar quads, at tolerances around their heights") {
+    const Mesh sphere = morph::make_uv_sphere(1.0, 40);
+    check_quad_variants(sphere, "uv sphere");
+    check_quad_variants(morph::read_mesh(std::string(MORPH_SAMPLES_DIR) + "/uvsphere_1600.off"),
+                        "uvsphere_1600");
+    // From far below the quads' rounding-level heights to above them, in steps that land
+    // between the heights of different faces (so that the first face named changes).
+    std::set<std::string> problems = {check_quad_paths(sphere, "uv sphere", 0)};
+    for (double t = 0x1p-60; t < 0x1p-40; t *= 1.19)
+      for (const double s : {1 - 0x1p-40, 1.0, 1 + 0x1p-40})
+        problems.insert(check_quad_paths(sphere, "uv sphere", t * s));
+    CHECK(problems.count("") == 1);  // the sweep ends above every height
+    CHECK(problems.size() > 10);     // and names many faces on its way
+  }
+  SUBCASE("meshes at the tolerance where their verdict turns") {
+    for (std::uint64_t seed = 1; seed <= 12; ++seed) {
+      const Mesh sphere = jittered(morph::make_uv_sphere(1.0, 6 + static_cast<int>(seed)),
+                                   seed % 2 ? 1e-10 : 1e-14, seed);
+      const std::string what = "jittered sphere " + std::to_string(seed);
+      check_at_boundary(sphere, what);
+      check_at_boundary(morph::test::scaled(sphere, 0x1p200), what + ", 2^200");
+      check_at_boundary(morph::test::scaled(sphere, 0x1p-200), what + ", 2^-200");
+      check_at_boundary(morph::test::translated(sphere, Point(1e6, -3e5, 2e6)), what + ", shifted");
+      check_at_boundary(jittered(mesh_of(cube_points(), kCubeQuads), 1e-11, seed),
+                        "jittered cube " + std::to_string(seed));
+    }
+    // Fine spheres jittered enough for a reflex edge (between quads, mostly) to bind.
+    for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+      const Mesh sphere = jittered(morph::make_uv_sphere(1.0, 100), 3e-5, seed);
+      const std::string what = "reflex sphere " + std::to_string(seed);
+      check_at_boundary(sphere, what);
+      check_at_boundary(morph::test::translated(sphere, Point(1e6, -3e5, 2e6)), what + ", shifted");
+    }
+    check_at_boundary(morph::make_uv_sphere(1.0, 40), "uv sphere");
+    check_at_boundary(morph::read_mesh(std::string(MORPH_SAMPLES_DIR) + "/uvsphere_1600.off"),
+                      "uvsphere_1600");
+  }
+  SUBCASE("a cube's corner lifted just inside and just outside the tolerance") {
+    // A unit square with one corner lifted by d has heights +-d / 4 about its Newell plane;
+    // the tolerance is 1e-9 times the diagonal (about sqrt(3)).
+    const double threshold = 4 * morph::kPlanarityTolerance * std::sqrt(3.0);
+    int passed = 0, failed = 0;
+    for (int j = -12; j <= 12; ++j)
+      for (const double sign : {1.0, -1.0}) {
+        // In steps of one ulp of 1 (a step of the lift changes the heights by a quarter of it).
+        std::vector<Point> points = cube_points();
+        points[7][2] = (1 + sign * threshold) + j * 0x1p-52;
+        const std::string problem = check_quad_variants(
+            mesh_of(points, kCubeQuads),
+            "lifted by " + std::to_string(sign) + " threshold + " + std::to_string(j) + " ulp");
+        ++(problem.empty() ? passed : failed);
+      }
+    CHECK(passed > 0);  // both verdicts within a few ulps of the threshold
+    CHECK(failed > 0);
+    for (int k = 20; k <= 40; ++k) {
+      std::vector<Point> points = cube_points();
+      points[7][2] -= std::ldexp(1.0, -k);
+      check_quad_variants(mesh_of(points, kCubeQuads), "lowered by 2^-" + std::to_string(k));
+    }
+  }
+  SUBCASE("reflex and nearly flat edges between quads (a roof's ridge)") {
+    std::set<std::string> problems;
+    for (int k = 18; k <= 44; ++k)
+      for (const double sign : {1.0, -1.0})
+        problems.insert(
+            check_quad_variants(house(1 + sign * std::ldexp(1.0, -k)),
+                                "ridge 1 + " + std::to_string(sign) + " 2^-" + std::to_string(k)));
+    CHECK(problems.count("") == 1);  // convex, or flat within the tolerance
+    CHECK(problems.size() > 1);      // and reflex beyond it
+    // A ridge a hair below flat is reflex beyond a tolerance found by the convexity tests of
+    // the roof's quads alone, across each corner's edge in turn.
+    for (int left = 0; left < 4; ++left)
+      for (int right = 0; right < 4; ++right)
+        for (const double h : {1 - 0x1p-30, 1 - 0x1p-33 * 3}) {
+          const Mesh roof = house(h, left, right);
+          const std::string what = "ridge " + std::to_string(h) + " from corners " +
+                                   std::to_string(left) + ", " + std::to_string(right);
+          check_at_boundary(roof, what);
+          check_at_boundary(morph::test::translated(roof, Point(1e6, -3e5, 2e6)),
+                            what + " shifted");
+        }
+    check_quad_variants(house(1), "flat roof");
+    check_quad_variants(house(1.5), "convex roof");
+    check_quad_variants(house(0.5), "reflex roof");
+    CHECK(contains(morph::check_convex_polyhedron(house(0.5)).problem, "is reflex"));
+  }
+  SUBCASE("non-convex, degenerate and pinched quads") {
+    std::vector<Point> dart = cube_points();
+    dart[7] = Point(0.4, 0.4, 1);  // the top quad turns non-convex (its sides bend)
+    check_quad_variants(mesh_of(dart, kCubeQuads), "dart");
+    dart[7] = Point(0.5, 0.5, 1);  // on the top's diagonal 5-6: a straight corner
+    check_quad_variants(mesh_of(dart, kCubeQuads), "on the diagonal");
+    std::vector<Point> pinched = cube_points();
+    pinched[7] = pinched[6];  // two corners of the top at one position
+    check_quad_variants(mesh_of(pinched, kCubeQuads), "two corners at one position");
+    CHECK(morph::check_convex_polyhedron(mesh_of(pinched, kCubeQuads)).problem ==
+          "face 1 has two vertices at the same position");
+    std::vector<Point> dented = cube_points();
+    dented[7] = Point(0.9, 0.9, 0.9);  // a corner pushed in: reflex edges, bent quads
+    check_quad_variants(mesh_of(dented, kCubeQuads), "dented");
+    std::vector<Point> flat = cube_points();
+    for (auto& p : flat) p[2] = 0;
+    check_quad_variants(mesh_of(flat, kCubeQuads), "flat");
+    check_quad_variants(mesh_of(cube_points(), reversed(kCubeQuads)), "inverted");
   }
 }

@@ -1268,8 +1268,7 @@ std::optional<Polytope> checked_polytope(const Mesh& mesh, const char* name) {
     // In sequence, the check on the walks' cycles (read once), before the build.
     walked = walk() && topology.passes;
     if (!walked) return std::nullopt;
-    const FaceCycleView cycles{p.face_begin.data(), p.corner_vertex.data(),
-                               topology.across.data()};
+    const FaceCycleView cycles{p.face_begin.data(), p.corner_vertex.data(), topology.across.data()};
     passes = geometry_passes(mesh, cycles);
     rejected = !passes;
     build();

@@ -539,8 +539,9 @@ bool quad_passes(const MeshView& m, const FaceCycles& cycles, int f, double tole
                          u[2] * (v[0] * w[1] - v[1] * w[0]);
     volumes.total += first;
     volumes.absolute += std::abs(first);
-    const double second = (u[0] * (w[1] * t[2] - w[2] * t[1]) + u[1] * (w[2] * t[0] - w[0] * t[2])) +
-                          u[2] * (w[0] * t[1] - w[1] * t[0]);
+    const double second =
+        (u[0] * (w[1] * t[2] - w[2] * t[1]) + u[1] * (w[2] * t[0] - w[0] * t[2])) +
+        u[2] * (w[0] * t[1] - w[1] * t[0]);
     volumes.total += second;
     volumes.absolute += std::abs(second);
   }
@@ -567,8 +568,10 @@ bool quad_passes(const MeshView& m, const FaceCycles& cycles, int f, double tole
 // `relative_tolerance` times the bounding-box diagonal. With `convexity` (only for a closed
 // mesh), also whether any edge may be reflex, with each face's plane while it is at hand.
 // `finite`: the caller has found every coordinate finite (the first test is skipped).
+// `shortcuts`: triangles and quadrilaterals take their unrolled paths (off only in tests,
+// which compare the two).
 Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& geometry,
-                      bool convexity = false, bool finite = false) {
+                      bool convexity = false, bool finite = false, bool shortcuts = true) {
   for (int v = 0; v < m.n_vertices && !finite; ++v) {
     if (!m.live_vertex(v)) continue;
     const Point& p = m.points[v];
@@ -593,11 +596,13 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
   for (int f = 0; f < m.n_faces; ++f) {
     if (!m.live_face(f)) continue;
     const int n = geometry.cycles.degree(f);
-    if (n == 3 && triangle_passes(m, geometry.cycles, f, tolerance, zero_area, convexity, centre,
-                                  volumes, non_planar_face, reflex))
+    if (n == 3 && shortcuts &&
+        triangle_passes(m, geometry.cycles, f, tolerance, zero_area, convexity, centre, volumes,
+                        non_planar_face, reflex))
       continue;
-    if (n == 4 && quad_passes(m, geometry.cycles, f, tolerance, zero_area, convexity, centre,
-                              volumes, non_planar_face, reflex))
+    if (n == 4 && shortcuts &&
+        quad_passes(m, geometry.cycles, f, tolerance, zero_area, convexity, centre, volumes,
+                    non_planar_face, reflex))
       continue;
     const int* ids = geometry.cycles.corners(f);
     const auto face = [&] { return "face " + std::to_string(f); };
@@ -691,11 +696,11 @@ Finding planar_and_convex(const MeshView& m, double relative_tolerance, const Ge
 
 // The full rule; stops at the first problem. An inverted mesh is reported as such
 // before the geometric checks (which assume outward normals).
-Finding convex_polyhedron(const Mesh& mesh, double relative_tolerance) {
+Finding convex_polyhedron(const Mesh& mesh, double relative_tolerance, bool shortcuts = true) {
   const MeshView m(mesh);
   if (Finding found = closed_manifold(m); found.verdict != Verdict::ok) return found;
   Geometry geometry;
-  if (Finding found = nondegenerate(m, relative_tolerance, geometry, true);
+  if (Finding found = nondegenerate(m, relative_tolerance, geometry, true, false, shortcuts);
       found.verdict != Verdict::ok)
     return found;
   if (Finding found = outward(geometry.volumes); found.verdict != Verdict::ok) return found;
@@ -793,6 +798,11 @@ bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles, double plana
   geometry.cycles.vertex = cycles.vertex;
   geometry.cycles.across = cycles.across;
   return geometry_of_cycles_passes(m, geometry, planarity_tolerance);
+}
+
+std::string convex_polyhedron_problem(const Mesh& mesh, double planarity_tolerance,
+                                      bool shortcuts) {
+  return convex_polyhedron(mesh, planarity_tolerance, shortcuts).problem;
 }
 
 bool geometry_passes(const Mesh& mesh, double planarity_tolerance) {

@@ -6,6 +6,7 @@
 #include <morph/validate.h>
 
 #include <optional>
+#include <string>
 #include <string_view>
 
 namespace morph::detail {
@@ -83,5 +84,10 @@ bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles,
 /// elements, with every coordinate finite; any other may be passed (a face that is not a
 /// closed cycle or an open edge gives false), the verdict then being meaningless.
 bool geometry_passes(const Mesh& mesh, double planarity_tolerance = kPlanarityTolerance);
+
+/// check_convex_polyhedron(mesh).problem with this tolerance, with or without the unrolled
+/// paths of triangles and quadrilaterals (`shortcuts`): for tests, which check that both give
+/// the same verdicts and messages.
+std::string convex_polyhedron_problem(const Mesh& mesh, double planarity_tolerance, bool shortcuts);
 
 }  // namespace morph::detail
