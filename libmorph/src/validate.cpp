@@ -497,15 +497,25 @@ bool reflex_across_small(const MeshView& m, const FaceCycles& cycles, const Heig
 // the general path's. Returns false, having changed nothing, when the quadrilateral repeats
 // a vertex or a position or has zero area: the general path then names the problem (a
 // repeated vertex does not zero a quadrilateral's normal, so both are tested here).
-bool quad_passes(const MeshView& m, const FaceCycles& cycles, int f, double tolerance,
-                 double zero_area, bool convexity, const Point& centre, FanVolumes& volumes,
-                 int& non_planar_face, bool& any_reflex) {
-  const int b = cycles.begin[f];
-  const int* ids = cycles.vertex + b;
+//
+// In two parts: quad_plane() reads only the corners (the plane and the fan volumes, ending in a
+// square root and a division), and nondegenerate() computes every quadrilateral's first, in a
+// loop whose iterations do not depend on each other (so that their chains of dependent
+// operations overlap), then the heights with quad_passes().
+struct QuadPlane {
+  double cx, cy, cz;     // the centroid
+  double nx, ny, nz;     // the unit normal
+  double first, second;  // six times the volumes of the fan's two tetrahedra
+  bool ok;               // false: a repeated vertex or position, or zero area (nothing else is set)
+};
+
+QuadPlane quad_plane(const MeshView& m, const int* ids, double zero_area, const Point& centre) {
+  QuadPlane q;
+  q.ok = false;
   const int i0 = ids[0], i1 = ids[1], i2 = ids[2], i3 = ids[3];
-  if (i0 == i1 || i0 == i2 || i0 == i3 || i1 == i2 || i1 == i3 || i2 == i3) return false;
+  if (i0 == i1 || i0 == i2 || i0 == i3 || i1 == i2 || i1 == i3 || i2 == i3) return q;
   const Point &p0 = m.points[i0], &p1 = m.points[i1], &p2 = m.points[i2], &p3 = m.points[i3];
-  if (p0 == p1 || p0 == p2 || p0 == p3 || p1 == p2 || p1 == p3 || p2 == p3) return false;
+  if (p0 == p1 || p0 == p2 || p0 == p3 || p1 == p2 || p1 == p3 || p2 == p3) return q;
   // newell_plane(): the centroid summed from zero and scaled by 1.0 / 4 (exactly 0.25).
   const double cx = ((((0.0 + p0[0]) + p1[0]) + p2[0]) + p3[0]) * (1.0 / 4);
   const double cy = ((((0.0 + p0[1]) + p1[1]) + p2[1]) + p3[1]) * (1.0 / 4);
@@ -516,36 +526,49 @@ bool quad_passes(const MeshView& m, const FaceCycles& cycles, int f, double tole
   const double bx = p1[0] - cx, by = p1[1] - cy, bz = p1[2] - cz;
   const double qx = p2[0] - cx, qy = p2[1] - cy, qz = p2[2] - cz;
   const double rx = p3[0] - cx, ry = p3[1] - cy, rz = p3[2] - cz;
-  double nx = (((0.0 + (ay * bz - az * by)) + (by * qz - bz * qy)) + (qy * rz - qz * ry)) +
-              (ry * az - rz * ay);
-  double ny = (((0.0 + (az * bx - ax * bz)) + (bz * qx - bx * qz)) + (qz * rx - qx * rz)) +
-              (rz * ax - rx * az);
-  double nz = (((0.0 + (ax * by - ay * bx)) + (bx * qy - by * qx)) + (qx * ry - qy * rx)) +
-              (rx * ay - ry * ax);
+  const double nx = (((0.0 + (ay * bz - az * by)) + (by * qz - bz * qy)) + (qy * rz - qz * ry)) +
+                    (ry * az - rz * ay);
+  const double ny = (((0.0 + (az * bx - ax * bz)) + (bz * qx - bx * qz)) + (qz * rx - qx * rz)) +
+                    (rz * ax - rx * az);
+  const double nz = (((0.0 + (ax * by - ay * bx)) + (bx * qy - by * qx)) + (qx * ry - qy * rx)) +
+                    (rx * ay - ry * ax);
   const double length = std::sqrt((nx * nx + ny * ny) + nz * nz);
-  if (!(length > zero_area)) return false;
+  if (!(length > zero_area)) return q;
   const double inverse = 1.0 / length;
-  nx *= inverse;
-  ny *= inverse;
-  nz *= inverse;
-  {
-    // FanVolumes::add_face(): the fan from the last corner, tetrahedra (r, a, b), (r, b, q).
-    const Point& o = centre;
-    const double u[3] = {p3[0] - o[0], p3[1] - o[1], p3[2] - o[2]};
-    const double v[3] = {p0[0] - o[0], p0[1] - o[1], p0[2] - o[2]};
-    const double w[3] = {p1[0] - o[0], p1[1] - o[1], p1[2] - o[2]};
-    const double t[3] = {p2[0] - o[0], p2[1] - o[1], p2[2] - o[2]};
-    const double first = (u[0] * (v[1] * w[2] - v[2] * w[1]) + u[1] * (v[2] * w[0] - v[0] * w[2])) +
-                         u[2] * (v[0] * w[1] - v[1] * w[0]);
-    volumes.total += first;
-    volumes.absolute += std::abs(first);
-    const double second =
-        (u[0] * (w[1] * t[2] - w[2] * t[1]) + u[1] * (w[2] * t[0] - w[0] * t[2])) +
-        u[2] * (w[0] * t[1] - w[1] * t[0]);
-    volumes.total += second;
-    volumes.absolute += std::abs(second);
-  }
+  q.cx = cx;
+  q.cy = cy;
+  q.cz = cz;
+  q.nx = nx * inverse;
+  q.ny = ny * inverse;
+  q.nz = nz * inverse;
+  // FanVolumes::add_face(): the fan from the last corner, tetrahedra (r, a, b), (r, b, q).
+  const Point& o = centre;
+  const double u[3] = {p3[0] - o[0], p3[1] - o[1], p3[2] - o[2]};
+  const double v[3] = {p0[0] - o[0], p0[1] - o[1], p0[2] - o[2]};
+  const double w[3] = {p1[0] - o[0], p1[1] - o[1], p1[2] - o[2]};
+  const double t[3] = {p2[0] - o[0], p2[1] - o[1], p2[2] - o[2]};
+  q.first = (u[0] * (v[1] * w[2] - v[2] * w[1]) + u[1] * (v[2] * w[0] - v[0] * w[2])) +
+            u[2] * (v[0] * w[1] - v[1] * w[0]);
+  q.second = (u[0] * (w[1] * t[2] - w[2] * t[1]) + u[1] * (w[2] * t[0] - w[0] * t[2])) +
+             u[2] * (w[0] * t[1] - w[1] * t[0]);
+  q.ok = true;
+  return q;
+}
+
+bool quad_passes(const MeshView& m, const FaceCycles& cycles, int f, const QuadPlane& q,
+                 double tolerance, bool convexity, FanVolumes& volumes, int& non_planar_face,
+                 bool& any_reflex) {
+  if (!q.ok) return false;
+  volumes.total += q.first;
+  volumes.absolute += std::abs(q.first);
+  volumes.total += q.second;
+  volumes.absolute += std::abs(q.second);
+  const int b = cycles.begin[f];
+  const int* ids = cycles.vertex + b;
+  const int i0 = ids[0], i1 = ids[1], i2 = ids[2], i3 = ids[3];
+  const Point &p0 = m.points[i0], &p1 = m.points[i1], &p2 = m.points[i2], &p3 = m.points[i3];
   // height(plane, p): dot(p - centroid, normal), summed in OpenMesh's order.
+  const double cx = q.cx, cy = q.cy, cz = q.cz, nx = q.nx, ny = q.ny, nz = q.nz;
   const auto height = [&](const Point& p) {
     return (p[0] - cx) * nx + (p[1] - cy) * ny + (p[2] - cz) * nz;
   };
@@ -593,6 +616,14 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
   int non_planar_face = geometry.non_planar_face;
   bool reflex = geometry.reflex;
   const Point centre = geometry.extent.centre;
+  // Every live quadrilateral's plane first (quad_plane() changes nothing); none when there
+  // are no quadrilaterals.
+  std::vector<QuadPlane> quad_planes;
+  for (int f = 0; f < m.n_faces && shortcuts; ++f) {
+    if (geometry.cycles.degree(f) != 4 || !m.live_face(f)) continue;
+    if (quad_planes.empty()) quad_planes.resize(m.n_faces);
+    quad_planes[f] = quad_plane(m, geometry.cycles.corners(f), zero_area, centre);
+  }
   for (int f = 0; f < m.n_faces; ++f) {
     if (!m.live_face(f)) continue;
     const int n = geometry.cycles.degree(f);
@@ -601,7 +632,7 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
                         non_planar_face, reflex))
       continue;
     if (n == 4 && shortcuts &&
-        quad_passes(m, geometry.cycles, f, tolerance, zero_area, convexity, centre, volumes,
+        quad_passes(m, geometry.cycles, f, quad_planes[f], tolerance, convexity, volumes,
                     non_planar_face, reflex))
       continue;
     const int* ids = geometry.cycles.corners(f);
