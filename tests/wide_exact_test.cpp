@@ -1,12 +1,14 @@
 // The fixed-point plane data of an erosion (libmorph/src/wide_exact.h): normals, offsets and
 // signs of dot products must be exactly the Mpzf values, in both word sizes (a small frame and
-// a large one), on nearly degenerate triangles, points scaled by 2^+-200, shifted far from the
-// origin, with zeros, tiny coordinates and subnormals; a frame it cannot hold (an infinity,
-// doubles too far apart) must say so.
+// a large one), and a normal's double-double copy within its bound, on nearly degenerate
+// triangles, points scaled by 2^+-200, shifted far from the origin, with zeros, tiny
+// coordinates and subnormals; a frame it cannot hold (an infinity, doubles too far apart) must
+// say so.
 #include "wide_exact.h"
 
 #include <doctest/doctest.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -36,6 +38,20 @@ int check(const Case& c) {
   f.set_normal(1, doubled);
   CHECK(doubled.x == n.x + n.x);
   CHECK(doubled.z == n.z + n.z);
+  std::array<DD, 3> dd;
+  if (f.normal_dd(1, dd)) {
+    // Within 2^-104 of |hi| (HalfSpace::normal_dd asks 2^-101), |lo| at most half an ulp.
+    const ExactN* exact[3] = {&doubled.x, &doubled.y, &doubled.z};
+    for (int k = 0; k < 3; ++k) {
+      const ExactN error = ExactN(dd[k].hi) + ExactN(dd[k].lo) - *exact[k];
+      CHECK(CGAL::abs(error) * ExactN(0x1p104) <= CGAL::abs(ExactN(dd[k].hi)));
+      const double half_ulp = 0.5 * std::abs(std::nextafter(dd[k].hi, 0.0) - dd[k].hi);
+      CHECK(std::abs(dd[k].lo) <= half_ulp);
+    }
+  } else {
+    const bool in_range = frame.small && std::abs(frame.unit) < 400;
+    CHECK_FALSE(in_range);
+  }
   const ExactN offset = dot(n, exact_difference(p, b));
   ExactN fo;
   f.set_dot(0, p, &b, fo);

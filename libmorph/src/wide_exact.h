@@ -10,6 +10,7 @@
 #include <gmp.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <cstring>
 #include <initializer_list>
@@ -302,6 +303,27 @@ class Normal {
       set_exact(small_, 2 * frame_.unit + doubling, normal);
     else
       set_exact(large_, 2 * frame_.unit + doubling, normal);
+  }
+  /// 2^doubling n in double-double, each component within 2^-104 of its |hi| (hi rounded to
+  /// nearest from the exact value, lo the rest rounded to nearest), as HalfSpace::normal_dd;
+  /// false for a large frame, or where the scaled words could leave 2^+-900 (then `out` is
+  /// unchanged).
+  bool normal_dd(int doubling, std::array<DD, 3>& out) const {
+    const int e = 2 * frame_.unit + doubling;
+    if (!frame_.small || e < -900 || e > 700) return false;  // |n| < 2^125
+    const std::uint64_t bits = static_cast<std::uint64_t>(1023 + e) << 52;
+    double scale;
+    std::memcpy(&scale, &bits, sizeof scale);
+    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    const i128 c[3] = {small_.x, small_.y, small_.z};
+    for (int k = 0; k < 3; ++k) {
+      // hi is an integer below 2^126, so c - hi is exact in 128 bits, and lo errs by at most
+      // 2^-53 |lo| <= 2^-106 |hi|; both scale exactly (non-zero ones are at least 2^e).
+      const double hi = static_cast<double>(c[k]);
+      const double lo = static_cast<double>(c[k] - static_cast<i128>(hi));
+      out[k] = {hi * scale, lo * scale};
+    }
+    return true;
   }
   /// Sets `out` (default-constructed: zero) to 2^doubling <n, u - v>, or <n, u> when v is null.
   void set_dot(int doubling, const V3<double>& u, const V3<double>* v, ExactN& out) const {
