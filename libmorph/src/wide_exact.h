@@ -62,20 +62,45 @@ inline Decoded decode(double d) {
   return r;
 }
 
+constexpr std::uint64_t kMantissa = (std::uint64_t{1} << 52) - 1;
+
+/// Whether simplify_quotient moves an Mpzf's exponent as set_exact expects (Mpzf(2^-64) is one
+/// word 1 with exponent -1, so that the quotient kept is x 2^64 / 1): checked once, so that
+/// another Mpzf layout sends every frame to the Mpzf code instead of giving wrong values.
+inline bool exponent_shift_works() {
+  static const bool works = [] {
+    ExactN x(1.5), unit(0x1p-64);
+    simplify_quotient(x, unit);
+    return unit == ExactN(1) && x == ExactN(0x1.8p64);
+  }();
+  return works;
+}
+
 /// Doubles scaled by 2^-unit, the smallest power of two of which each is an integer
 /// multiple: each then an integer below 2^kInputBits, or the frame is not ok.
 class Frame {
  public:
   explicit Frame(std::initializer_list<double> values) {
-    int low = 1 << 20, high = -(1 << 20);
+    // The lowest set bit of any value, and the largest magnitude (non-negative doubles
+    // order as their bit patterns; an infinity or a NaN is above every finite one).
+    int low = 1 << 20;
+    std::uint64_t largest = 0;
     for (double d : values) {
-      const Decoded x = decode(d);
-      if (!x.finite) return;
-      if (x.m == 0) continue;
-      low = std::min(low, x.e);
-      high = std::max(high, x.e + 64 - __builtin_clzll(x.m));  // 2^high > |d|
+      std::uint64_t bits;
+      std::memcpy(&bits, &d, sizeof bits);
+      bits &= ~(std::uint64_t{1} << 63);
+      if (bits == 0) continue;
+      largest = std::max(largest, bits);
+      const int biased = static_cast<int>(bits >> 52);
+      const std::uint64_t m = biased != 0 ? (bits & kMantissa) | (kMantissa + 1) : bits;
+      low = std::min(low, std::max(biased, 1) - 1075 + __builtin_ctzll(m));
     }
-    if (high < low) {  // all zero
+    // Not ok for an infinity or a NaN (or an Mpzf that set_exact cannot make).
+    if (largest >= 0x7ff0000000000000 || !exponent_shift_works()) return;
+    const int biased = static_cast<int>(largest >> 52);
+    // 2^high > |d| for every value.
+    const int high = biased != 0 ? biased - 1022 : -1074 + 64 - __builtin_clzll(largest);
+    if (largest == 0) {  // all zero
       unit = 0;
       ok = small = true;
       scale_ = 1;
