@@ -13,6 +13,7 @@
 #include "gauss_map.h"
 #include "halfspace_intersection.h"
 #include "parallel.h"
+#include "wide_exact.h"
 
 namespace morph::detail {
 
@@ -216,12 +217,24 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
         // points: its Newell normal is (q - p) x (r - p), the same value in fewer products,
         // its corners lie exactly on that plane, and h_A - h_B = <n, p - b> in one dot
         // product; differences of doubles as exact_difference.
-        h.normal = triangle_normal(A, f);
-        // Its double-double copy from the doubles (cheaper than from the exact value).
-        set_normal_dd(h, A.points[A.corner(f, 0)], A.points[A.corner(f, 1)],
-                      A.points[A.corner(f, 2)]);
-        h.offset = dot(h.normal, exact_difference(A.points[A.corner(f, 0)], B.points[b]));
+        const V3<double>&p = A.points[A.corner(f, 0)], &q = A.points[A.corner(f, 1)],
+              &r = A.points[A.corner(f, 2)], &pb = B.points[b];
         on[0] = on[1] = on[2] = 1;
+        // In fixed point (wide_exact.h) when the doubles allow, else in Mpzf: the same values.
+        // The normal's double-double copy from its exact words, or from the doubles (cheaper
+        // than from the exact value).
+        const fixed::Frame frame{p.x, p.y, p.z, q.x, q.y, q.z, r.x, r.y, r.z, pb.x, pb.y, pb.z};
+        if (frame.ok) {
+          const fixed::Normal n(frame, p, q, p, r);
+          n.set_normal(0, h.normal);  // hs's are new: zero
+          n.set_dot(0, p, &pb, h.offset);
+          h.has_normal_dd = n.normal_dd(0, h.normal_dd);
+          if (!h.has_normal_dd) set_normal_dd(h, p, q, r);
+        } else {
+          set_normal_dd(h, p, q, r);
+          h.normal = triangle_normal(A, f);
+          h.offset = dot(h.normal, exact_difference(p, pb));
+        }
         add_others_on_plane(h.normal);
         continue;
       }
@@ -233,12 +246,32 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
         // product. h_A is attained at the corners p_k with the largest <n, p_k - p0> (exact
         // dots of double differences, as the triangle's), and h_A - h_B = <n, p_best - b>.
         const auto corner = [&](int k) -> const V3<double>& { return A.points[A.corner(f, k)]; };
+        const V3<double>&p0 = corner(0), &p1 = corner(1), &p2 = corner(2), &p3 = corner(3),
+              &pb = B.points[b];
+        // n is orthogonal to both diagonals, so <n, p2 - p0> = 0 and <n, p3 - p1> = 0: the
+        // heights are 0, h, 0, h for h = <n, p1 - p0>, and its sign alone gives the top
+        // corners: 1 and 3 when h > 0, 0 and 2 when h < 0, all four when the quadrilateral is
+        // planar.
+        const auto set_top = [&](int sign) {
+          const int top = sign > 0 ? 1 : 0;
+          for (int k = 0; k < 4; ++k) on[k] = sign == 0 || k % 2 == top;
+          return top;
+        };
+        // In fixed point (wide_exact.h) when the doubles allow.
+        const fixed::Frame frame{p0.x, p0.y, p0.z, p1.x, p1.y, p1.z, p2.x, p2.y,
+                                 p2.z, p3.x, p3.y, p3.z, pb.x, pb.y, pb.z};
+        if (frame.ok) {
+          const fixed::Normal n(frame, p0, p2, p1, p3);
+          const int top = set_top(n.sign_dot(p1, p0));
+          n.set_normal(0, h.normal);  // hs's are new: zero
+          n.set_dot(0, top == 1 ? p1 : p0, &pb, h.offset);
+          h.has_normal_dd = n.normal_dd(0, h.normal_dd);
+          add_others_on_plane(h.normal);
+          continue;
+        }
         h.normal = cross(exact_difference(corner(2), corner(0)),
                          exact_difference(corner(3), corner(1)));
-        // n is orthogonal to both diagonals, so <n, p2 - p0> = 0 and <n, p3 - p1> = 0: the
-        // heights are 0, h, 0, h for h = <n, p1 - p0>, and its sign alone (intervals, exact
-        // when they cannot tell) gives the top corners: 1 and 3 when h > 0, 0 and 2 when
-        // h < 0, all four when the quadrilateral is planar.
+        // The sign of h by intervals, exact when they cannot tell.
         int sign;
         {
           RoundingGuard guard;
@@ -246,8 +279,7 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
               dot(to_interval_n(h.normal), to_interval(corner(1)) - to_interval(corner(0))));
         }
         if (sign == 2) sign = CGAL::sign(dot(h.normal, exact_difference(corner(1), corner(0))));
-        const int top = sign > 0 ? 1 : 0;
-        for (int k = 0; k < 4; ++k) on[k] = sign == 0 || k % 2 == top;
+        const int top = set_top(sign);
         h.offset = dot(h.normal, exact_difference(corner(top), B.points[b]));
         add_others_on_plane(h.normal);
         continue;
@@ -400,16 +432,41 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
       int b = -1;
       bool found = false;   // h.normal is S's normal n (the faces along n exactly planar)
       bool simple = false;  // translated, corner or parallelogram: n from A's or B's facet
+      // h.offset is <n, a> for a corner (a, b_j) of the facet (see below).
+      const V3<double>& a = A.points[i_at(0)];
+      bool offset_set = false;
+      // h.normal = 2^doubling (x1 - x0) x (y1 - y0) and h.offset in fixed point
+      // (wide_exact.h) when the doubles allow; false when they do not.
+      const auto fixed_plane = [&](const V3<double>& x0, const V3<double>& x1, const V3<double>& y0,
+                                   const V3<double>& y1, int doubling) {
+        const fixed::Frame frame{x0.x, x0.y, x0.z, x1.x, x1.y, x1.z, y0.x, y0.y,
+                                 y0.z, y1.x, y1.y, y1.z, a.x,  a.y,  a.z};
+        if (!frame.ok) return false;
+        const fixed::Normal n(frame, x0, x1, y0, y1);
+        n.set_normal(doubling, h.normal);  // hs's are new: zero
+        n.set_dot(doubling, a, nullptr, h.offset);
+        offset_set = true;
+        return true;
+      };
+      // planar_normal into h.normal; a triangle's (its normal (q - p) x (r - p)) in fixed
+      // point first.
+      const auto planar = [&](const Polytope& P, int f) {
+        if (P.degree(f) == 3) {
+          const V3<double>& p = P.points[P.corner(f, 0)];
+          if (fixed_plane(p, P.points[P.corner(f, 1)], p, P.points[P.corner(f, 2)], 0)) return true;
+        }
+        return planar_normal(P, f, &h.normal);
+      };
       if (one_j && g < na && same_cycle(A, g, d, i_at)) {
         simple = true;
-        found = planar_normal(A, g, &h.normal);
+        found = planar(A, g);
         b = j_at(0);
       } else if (one_i) {
         const int e = d >= 3 ? B.edge_between(j_at(0), j_at(1)) : -1;
         const int f = e < 0 ? -1 : B.edges[e].from == j_at(0) ? B.edges[e].left : B.edges[e].right;
         if (same_cycle(B, f, d, j_at)) {
           simple = true;
-          found = planar_normal(B, f, &h.normal);
+          found = planar(B, f);
           b = B.corner(f, 0);
           for (int k = 1; k < d; ++k) others[g].push_back(B.corner(f, k));
         }
@@ -417,21 +474,25 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
         // A parallelogram: each side moves one operand's vertex, alternately. Its Newell
         // normal is twice (P1 - P0) x (P2 - P1).
         bool parallelogram = true;
-        V3<ExactN> side[2];
+        const V3<double>* side[2][2];  // side k runs from side[k][0] to side[k][1]
         for (int k = 0; k < 4 && parallelogram; ++k) {
           const int l = (k + 1) % 4;
           const bool moves_a = i_at(k) != i_at(l), moves_b = j_at(k) != j_at(l);
           const bool like_first = moves_a == (i_at(0) != i_at(1));
           parallelogram = moves_a != moves_b && like_first == (k % 2 == 0);
-          if (parallelogram && k < 2)
-            side[k] = moves_a ? exact_difference(A.points[i_at(l)], A.points[i_at(k)])
-                              : exact_difference(B.points[j_at(l)], B.points[j_at(k)]);
+          if (parallelogram && k < 2) {
+            side[k][0] = moves_a ? &A.points[i_at(k)] : &B.points[j_at(k)];
+            side[k][1] = moves_a ? &A.points[i_at(l)] : &B.points[j_at(l)];
+          }
         }
         const int e = parallelogram ? B.edge_between(j_at(0), j_at(2)) : -1;
         if (e >= 0) {
           simple = true;
-          const V3<ExactN> m = cross(side[0], side[1]);
-          h.normal = {m.x + m.x, m.y + m.y, m.z + m.z};
+          if (!fixed_plane(*side[0][0], *side[0][1], *side[1][0], *side[1][1], 1)) {
+            const V3<ExactN> m = cross(exact_difference(*side[0][1], *side[0][0]),
+                                       exact_difference(*side[1][1], *side[1][0]));
+            h.normal = {m.x + m.x, m.y + m.y, m.z + m.z};
+          }
           found = true;
           b = B.edges[e].from;
           others[g].push_back(B.edges[e].to);
@@ -490,7 +551,7 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
       }
       // Every corner (i, j) of the facet lies on its plane, and j on B's face for its normal:
       // h_S - h_B = <n, a_i + b_j> - <n, b_j> = <n, a_i>.
-      h.offset = dot(h.normal, to_exact_n(A.points[i_at(0)]));
+      if (!offset_set) h.offset = dot(h.normal, to_exact_n(a));
       h.source = g;
       h.element = B.vertex_source[b];
       contributing[g] = b;
