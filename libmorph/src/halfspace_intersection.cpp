@@ -18,7 +18,7 @@
 // by one vertex of B) make vertices without exact constructions and zero tests free, and
 // an expected result (ExpectedVertices: A's vertices, opened up by exact flips where the
 // moved planes around one no longer meet in a point; a closing's A) replaces the hull when it
-// passes the check.
+// passes the check, or, when only some of its edges fail, once flips have repaired those.
 #include "halfspace_intersection.h"
 
 #include <CGAL/Lazy_kernel.h>
@@ -845,15 +845,187 @@ Polytope verified_polytope(std::vector<V3<double>> points, ExactPoints exact,
   return p;
 }
 
+/// Actions (flips and removals) per triangle after which a repair gives up: a guess that
+/// needs more is far from the result, and the hull is then the cheaper route.
+constexpr int kRepairsPerTriangle = 1;
+
+/// Repairs a candidate dual surface (closed, oriented, every triangle positively oriented
+/// about o) whose edges `reflex` (triangle, edge) are not locally convex: the far corner d
+/// of the triangle across edge a -> c of triangle (a, c, b) cuts off that triangle's
+/// vertex (side > 0, exactly). Such an edge is flipped to (b, d) when both new triangles
+/// are positively oriented and b, d are not joined yet (a 2-2 flip: the enclosed region
+/// grows by the tetrahedron a, b, c, d); otherwise an end of the edge with three
+/// neighbours is removed (a 3-1 flip: its dual point is beneath the triangle of its
+/// neighbours, the same four points; its plane does not bound the intersection), when that
+/// triangle is positively oriented. Each action is followed by the tests of the edges
+/// around it; an edge that neither action can repair yet waits until others have acted.
+/// Every triangle made keeps det > 0, so the repaired surface still winds once around o.
+/// Lawson's flips for a convex hull need not finish (a reflex edge may have no valid
+/// action): false then, or after kRepairsPerTriangle actions per triangle, and the hull
+/// is computed. The result is checked exactly like any candidate (build_verified), so the
+/// repair only has to be right where it acts, not complete.
+/// Triangles removed are dropped from `s`; triangles changed have no vertex (has_vertex).
+bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& precise,
+                    const KnownPoints& known, DualSurface& s,
+                    const std::vector<std::pair<int, int>>& reflex) {
+  RoundingGuard guard;
+  const int nt = static_cast<int>(s.corner.size());
+  std::vector<char> dead(nt, 0);
+  const auto next = [](int k) { return k == 2 ? 0 : k + 1; };
+  const auto prev = [](int k) { return k == 0 ? 2 : k - 1; };
+  const auto slot_of = [&](int t, int a) {
+    for (int k = 0; k < 3; ++k)
+      if (s.corner[t][k] == a) return k;
+    return -1;
+  };
+  const auto vertex_at = [&](int t) -> HVertex& {
+    if (!s.has_vertex[t]) {
+      s.vertex[t] = independent_vertex_of(planes, s.corner[t], known);
+      s.has_vertex[t] = 1;
+    }
+    return s.vertex[t];
+  };
+  const auto positive = [&](int a, int b, int c) {
+    return det_sign(planes[a], planes[b], planes[c]) > 0;
+  };
+  // Sets the across of triangle t's edge x -> y to `to`; false when t has no such edge.
+  const auto relink = [&](int t, int x, int y, int to) {
+    const int k = slot_of(t, x);
+    if (k < 0 || s.corner[t][next(k)] != y) return false;
+    s.across[t][k] = to;
+    return true;
+  };
+  // The triangles around corner a of triangle t, up to `limit` + 1 (the fan is followed
+  // through the triangle across each edge leaving a); `visit` sees each one's other
+  // corner along that edge.
+  const auto around = [&](int t, int a, int limit, const auto& visit) {
+    int count = 0, u = t;
+    do {
+      const int k = slot_of(u, a);
+      if (k < 0 || ++count > limit) return limit + 1;
+      visit(s.corner[u][next(k)]);
+      u = s.across[u][k];
+    } while (u != t);
+    return count;
+  };
+  constexpr int kMaxDegree = 1 << 12;
+  std::vector<std::array<int, 3>> queue, waiting;  // (t, a, c): the edge a -> c of t
+  for (auto it = reflex.rbegin(); it != reflex.rend(); ++it)
+    queue.push_back({it->first, s.corner[it->first][it->second],
+                     s.corner[it->first][next(it->second)]});
+  const auto push_edges = [&](int t) {
+    for (int k = 2; k >= 0; --k) queue.push_back({t, s.corner[t][k], s.corner[t][next(k)]});
+  };
+  // Removes corner slot i of triangle t when it has three neighbours: t = (x, y, z),
+  // u = (y, x, d) across x -> y, w = (x, z, d) across z -> x become (y, z, d) in t.
+  const auto remove = [&](int t, int i) {
+    const int x = s.corner[t][i], y = s.corner[t][next(i)], z = s.corner[t][prev(i)];
+    const int u = s.across[t][i], w = s.across[t][prev(i)];
+    const int jx = slot_of(u, x), mx = slot_of(w, x);
+    if (u == w || jx < 0 || mx < 0) return false;
+    const int d = s.corner[u][next(jx)];
+    if (s.corner[w][prev(mx)] != d || s.across[u][jx] != w) return false;  // degree > 3
+    const int Y = s.across[u][next(jx)], Z = s.across[w][next(mx)], X = s.across[t][next(i)];
+    for (int o : {X, Y, Z})
+      if (o == t || o == u || o == w) return false;
+    if (!positive(y, z, d)) return false;
+    if (!relink(Z, d, z, t) || !relink(Y, y, d, t)) return false;
+    s.corner[t] = {y, z, d};
+    s.across[t] = {X, Z, Y};
+    s.has_vertex[t] = 0;
+    dead[u] = dead[w] = 1;
+    push_edges(t);
+    return true;
+  };
+  int budget = kRepairsPerTriangle * nt + 16;
+  bool progress = false;
+  while (true) {
+    if (queue.empty()) {
+      if (waiting.empty()) break;
+      if (!progress) return false;
+      progress = false;
+      std::swap(queue, waiting);
+      std::reverse(queue.begin(), queue.end());
+      continue;
+    }
+    const auto [t, a, c] = queue.back();
+    queue.pop_back();
+    if (dead[t]) continue;
+    const int i = slot_of(t, a);
+    if (i < 0 || s.corner[t][next(i)] != c) continue;  // changed meanwhile
+    const int u = s.across[t][i], j = slot_of(u, c);
+    if (j < 0 || s.corner[u][next(j)] != a) return false;  // not a closed oriented surface
+    const int b = s.corner[t][prev(i)], d = s.corner[u][prev(j)];
+    HVertex& v = vertex_at(t);
+    // (W > 0: a known point, or the meet of positively oriented planes; independent_vertex_of
+    // and the checks' side tests assume the same.)
+    if (known_through(known, d, v) || side(planes, precise, d, v) <= 0) continue;
+    if (--budget < 0) return false;
+    const int X1 = s.across[t][next(i)], X2 = s.across[t][prev(i)],
+              Y1 = s.across[u][next(j)], Y2 = s.across[u][prev(j)];
+    bool joined = b == d;
+    if (!joined)
+      around(t, b, kMaxDegree, [&](int w) { joined = joined || w == d; });
+    bool outer_ok = true;
+    for (int o : {X1, X2, Y1, Y2})
+      if (o == t || o == u) outer_ok = false;
+    if (!joined && outer_ok && positive(a, d, b) && positive(d, c, b)) {
+      if (!relink(Y1, d, a, t) || !relink(X1, b, c, u)) return false;
+      s.corner[t] = {a, d, b};
+      s.across[t] = {Y1, u, X2};
+      s.corner[u] = {d, c, b};
+      s.across[u] = {Y2, X1, t};
+      s.has_vertex[t] = s.has_vertex[u] = 0;
+      queue.push_back({t, b, a});
+      queue.push_back({u, c, b});
+      queue.push_back({u, d, c});
+      queue.push_back({t, a, d});
+      progress = true;
+      continue;
+    }
+    if (remove(t, i) || remove(t, next(i))) {
+      progress = true;
+      continue;
+    }
+    ++budget;
+    waiting.push_back({t, a, c});
+  }
+  // Drop the removed triangles.
+  std::vector<int> index(nt, -1);
+  int kept = 0;
+  for (int t = 0; t < nt; ++t)
+    if (!dead[t]) index[t] = kept++;
+  for (int t = 0; t < nt; ++t) {
+    if (dead[t]) continue;
+    const int r = index[t];
+    s.corner[r] = s.corner[t];
+    s.across[r] = {index[s.across[t][0]], index[s.across[t][1]], index[s.across[t][2]]};
+    if (r != t) s.vertex[r] = std::move(s.vertex[t]);
+    s.has_vertex[r] = s.has_vertex[t];
+  }
+  s.corner.resize(kept);
+  s.across.resize(kept);
+  s.vertex.resize(kept);
+  s.has_vertex.resize(kept);
+  for (const auto& a : s.across)
+    for (int x : a)
+      if (x < 0) return false;
+  return kept >= 4;
+}
+
 /// Builds the intersection from a candidate dual hull, checking exactly that it is the
 /// dual hull of all the planes; nullopt when it is not. The result has `rounded`, and
 /// `polytope` when options.polytope (its exact points computed up front when
 /// options.eager_exact, else on demand: polytope_points).
+/// `repaired`, when not null (a guess, with its triangles' vertices), allows edges that are
+/// not locally convex to be repaired (repair_surface) and the result checked again; it
+/// tells whether that happened.
 std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
                                             const std::vector<Plane>& planes,
                                             const PrecisePlanes& precise,
                                             const KnownPoints& known, DualSurface s,
-                                            const IntersectOptions& options) {
+                                            const IntersectOptions& options,
+                                            bool* repaired = nullptr) {
   const bool with_polytope = options.polytope;
   const int nt = static_cast<int>(s.corner.size());
   const int n = static_cast<int>(planes.size());
@@ -913,6 +1085,8 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   // and the signs are the group's. A surface without vertices gets none stored (large,
   // and most would be dropped): each is made for its tests, and the seeds' again below.
   const bool stored = !s.vertex.empty();
+  const bool can_repair = repaired && stored;
+  std::atomic<bool> reflex = false;  // an edge to repair
   std::vector<signed char> far_side(3 * static_cast<std::size_t>(nt));
   parallel_chunks(nt, 256, [&](int begin, int end) {
     RoundingGuard guard;
@@ -940,12 +1114,28 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
         const int sd = far < 0                        ? 1
                        : known_through(known, far, v) ? 0
                                                       : side(planes, precise, far, v);
-        if (sd > 0) ok = false;
+        if (sd > 0) {
+          if (can_repair)
+            reflex = true;
+          else
+            ok = false;
+        }
         far_side[3 * t + k] = static_cast<signed char>(sd);
       }
     }
   });
   if (!ok) return std::nullopt;
+  if (reflex) {
+    // Every triangle's vertex is computed now (stored): the repair keeps those it leaves.
+    std::fill(s.has_vertex.begin(), s.has_vertex.end(), 1);
+    std::vector<std::pair<int, int>> edges;
+    for (int t = 0; t < nt; ++t)
+      for (int k = 0; k < 3; ++k)
+        if (far_side[3 * t + k] > 0) edges.emplace_back(t, k);
+    if (!repair_surface(planes, precise, known, s, edges)) return std::nullopt;
+    *repaired = true;
+    return build_verified(hs, planes, precise, known, std::move(s), options);
+  }
   std::vector<int> group(nt, -1), seed;
   {
     std::vector<int> stack;
@@ -1779,10 +1969,6 @@ struct PolygonScratch {
 /// take O(k^2) on a vertex of A of high degree, and the hull is then the cheaper route.
 constexpr int kFlipsPerCorner = 4;
 
-/// Polygons of more planes than this are triangulated first, and tested against the planes
-/// nearby (expected_surface).
-constexpr int kLargePolygon = 8;
-
 /// Triangulates the polygon of planes p[0 .. k) (counter-clockwise seen from outside) so
 /// that it is locally convex, as the dual hull is: Lawson flips from a fan. The diagonal
 /// (a, c) between triangles (a, c, b) and (c, a, d) is flipped to (b, d) when plane d cuts
@@ -1920,65 +2106,10 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const PrecisePlan
                              expected.split ? &s.has_vertex[first[v]] : nullptr, scratch))
       ok = false;
   };
-  // Polygons of many planes first, each with a test that rejects a doomed guess early: where
-  // facets of A vanish (the thin facets around the pole of a UV sphere), a vertex of such a
-  // polygon's triangles is cut off by a plane of a polygon nearby. The planes of the polygons
-  // that share a plane with it are tested at its triangles' vertices; one that cuts a vertex
-  // off (side > 0, exactly) proves the guess wrong (a right one has every triangle's vertex
-  // a vertex of the intersection, inside every half-space), and the hull is computed without
-  // triangulating the rest. Each polygon's triangles do not depend on the order.
-  const auto size = [&](int v) { return expected.begin[v + 1] - expected.begin[v]; };
-  std::vector<int> large_polygons;
-  if (expected.split)
-    for (int v = 0; v < nv; ++v)
-      if (size(v) > kLargePolygon) large_polygons.push_back(v);
-  if (!large_polygons.empty()) {
-    // The polygons through each plane (a counting sort of the expected facets).
-    const int n = static_cast<int>(planes.size());
-    std::vector<int> through_begin(n + 1, 0), through(expected.facets.size());
-    for (int i : expected.facets) ++through_begin[i + 1];
-    std::partial_sum(through_begin.begin(), through_begin.end(), through_begin.begin());
-    {
-      std::vector<int> next(through_begin.begin(), through_begin.end() - 1);
-      for (int v = 0; v < nv; ++v)
-        for (int j = expected.begin[v]; j < expected.begin[v + 1]; ++j)
-          through[next[expected.facets[j]]++] = v;
-    }
-    parallel_chunks(static_cast<int>(large_polygons.size()), 1, [&](int begin, int end) {
-      RoundingGuard guard;
-      PolygonScratch scratch;
-      std::vector<int> nearby;
-      for (int j = begin; j < end && ok; ++j) {
-        const int v = large_polygons[j];
-        triangulate(v, scratch);
-        if (!ok) break;
-        const int* p = &expected.facets[expected.begin[v]];
-        nearby.clear();
-        for (int i = 0; i < size(v); ++i)
-          for (int w = through_begin[p[i]]; w < through_begin[p[i] + 1]; ++w)
-            for (int c = expected.begin[through[w]]; c < expected.begin[through[w] + 1]; ++c)
-              if (std::find(p, p + size(v), expected.facets[c]) == p + size(v))
-                nearby.push_back(expected.facets[c]);
-        std::sort(nearby.begin(), nearby.end());
-        nearby.erase(std::unique(nearby.begin(), nearby.end()), nearby.end());
-        for (int t = first[v]; t < first[v + 1] && ok; ++t) {
-          HVertex& x = s.vertex[t];
-          // (W > 0 for the sign below: a known point, or positive by intervals.)
-          if (!s.has_vertex[t] || (x.known < 0 && !(x.Wi.inf() > 0))) continue;
-          for (int i : nearby)
-            if (!known_through(known, i, x) && side(planes, precise, i, x) > 0) {
-              ok = false;
-              break;
-            }
-        }
-      }
-    });
-  }
   parallel_chunks(ok ? nv : 0, 64, [&](int begin, int end) {
     RoundingGuard guard;
     PolygonScratch scratch;
-    for (int v = begin; v < end && ok; ++v)
-      if (large_polygons.empty() || size(v) <= kLargePolygon) triangulate(v, scratch);
+    for (int v = begin; v < end && ok; ++v) triangulate(v, scratch);
   });
   if (!ok) return {};
   // Directed edges 3 t + k (corner k to k + 1 of triangle t) listed by their first plane
@@ -2045,9 +2176,11 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
   // the duality argument hold, so the rounded o only has to centre the virtual planes.
   const PrecisePlanes precise(planes);
   if (options.incremental && options.guess && !expected.empty()) {
+    bool repaired = false;
     if (auto built = build_verified(hs, planes, precise, known,
-                                    expected_surface(planes, precise, known, expected), options)) {
-      built->route = HullRoute::expected;
+                                    expected_surface(planes, precise, known, expected), options,
+                                    &repaired)) {
+      built->route = repaired ? HullRoute::repaired : HullRoute::expected;
       return std::move(*built);
     }
   }
