@@ -76,6 +76,13 @@ struct Plane {
   const HalfSpace* source = nullptr;  // its normal's double-double copy, when it has one
 };
 
+/// The interval of a component in double-double within 2^-101 of its |hi| (as
+/// HalfSpace::normal_dd; needs a RoundingGuard: the bound rounds up).
+Interval dd_interval(const DD& c) {
+  const double e = 0x1p-101 * std::abs(c.hi);
+  return Interval(c.hi) + Interval(c.lo) + Interval(-e, e);
+}
+
 std::vector<Plane> planes_of(const std::vector<HalfSpace>& hs) {
   std::vector<Plane> planes(hs.size());
   parallel_chunks(static_cast<int>(hs.size()), 256, [&](int begin, int end) {
@@ -86,8 +93,14 @@ std::vector<Plane> planes_of(const std::vector<HalfSpace>& hs) {
       p.n = q == 1 ? hs[i].normal
                    : V3<ExactN>{hs[i].normal.x * q, hs[i].normal.y * q, hs[i].normal.z * q};
       p.d = hs[i].offset;
-      if (q == 1 && hs[i].has_normal_dd) p.source = &hs[i];
-      p.ni = to_interval_n(p.n);
+      if (q == 1 && hs[i].has_normal_dd) {
+        // The normal's enclosure from its double-double copy (cheaper than from Mpzf).
+        p.source = &hs[i];
+        const auto& c = hs[i].normal_dd;
+        p.ni = {dd_interval(c[0]), dd_interval(c[1]), dd_interval(c[2])};
+      } else {
+        p.ni = to_interval_n(p.n);
+      }
       p.di = to_interval_n(p.d);
     }
   });
@@ -173,6 +186,9 @@ struct DualSurface {
   std::vector<std::array<int, 3>> across;
   std::vector<HVertex> vertex;  // empty, or one per triangle
   std::vector<char> has_vertex;
+  // Empty, or per plane: a triangle near the plane's dual point, for one that is not on the
+  // surface (removed by a repair), where the check's climb starts; -1 where none is known.
+  std::vector<int> near;
 };
 
 /// The triangles of a hull computed by CGAL; empty when it is not a closed triangulated
@@ -909,10 +925,11 @@ bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& preci
     return count;
   };
   constexpr int kMaxDegree = 1 << 12;
+  s.near.assign(planes.size(), -1);
   std::vector<std::array<int, 3>> queue, waiting;  // (t, a, c): the edge a -> c of t
   for (auto it = reflex.rbegin(); it != reflex.rend(); ++it)
-    queue.push_back({it->first, s.corner[it->first][it->second],
-                     s.corner[it->first][next(it->second)]});
+    queue.push_back(
+        {it->first, s.corner[it->first][it->second], s.corner[it->first][next(it->second)]});
   const auto push_edges = [&](int t) {
     for (int k = 2; k >= 0; --k) queue.push_back({t, s.corner[t][k], s.corner[t][next(k)]});
   };
@@ -930,6 +947,7 @@ bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& preci
       if (o == t || o == u || o == w) return false;
     if (!positive(y, z, d)) return false;
     if (!relink(Z, d, z, t) || !relink(Y, y, d, t)) return false;
+    s.near[x] = t;  // x's dual point lies beneath t
     s.corner[t] = {y, z, d};
     s.across[t] = {X, Z, Y};
     s.has_vertex[t] = 0;
@@ -961,11 +979,10 @@ bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& preci
     // and the checks' side tests assume the same.)
     if (known_through(known, d, v) || side(planes, precise, d, v) <= 0) continue;
     if (--budget < 0) return false;
-    const int X1 = s.across[t][next(i)], X2 = s.across[t][prev(i)],
-              Y1 = s.across[u][next(j)], Y2 = s.across[u][prev(j)];
+    const int X1 = s.across[t][next(i)], X2 = s.across[t][prev(i)], Y1 = s.across[u][next(j)],
+              Y2 = s.across[u][prev(j)];
     bool joined = b == d;
-    if (!joined)
-      around(t, b, kMaxDegree, [&](int w) { joined = joined || w == d; });
+    if (!joined) around(t, b, kMaxDegree, [&](int w) { joined = joined || w == d; });
     bool outer_ok = true;
     for (int o : {X1, X2, Y1, Y2})
       if (o == t || o == u) outer_ok = false;
@@ -995,6 +1012,11 @@ bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& preci
   int kept = 0;
   for (int t = 0; t < nt; ++t)
     if (!dead[t]) index[t] = kept++;
+  for (int& t : s.near) {
+    // (A triangle removed since: its dual point's neighbour, still near.)
+    if (t >= 0 && dead[t]) t = s.across[t][0];
+    if (t >= 0) t = index[t];
+  }
   for (int t = 0; t < nt; ++t) {
     if (dead[t]) continue;
     const int r = index[t];
@@ -1022,9 +1044,8 @@ bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& preci
 /// tells whether that happened.
 std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
                                             const std::vector<Plane>& planes,
-                                            const PrecisePlanes& precise,
-                                            const KnownPoints& known, DualSurface s,
-                                            const IntersectOptions& options,
+                                            const PrecisePlanes& precise, const KnownPoints& known,
+                                            DualSurface s, const IntersectOptions& options,
                                             bool* repaired = nullptr) {
   const bool with_polytope = options.polytope;
   const int nt = static_cast<int>(s.corner.size());
@@ -1032,12 +1053,20 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   if (nt == 0) return std::nullopt;
   // Every triangle sees o on its inner side: det(n_a, n_b, n_c) > 0 (dual points are the
   // normals scaled by positive factors).
+  // A vertex the candidate computed from its corners' planes, in order (not a known point),
+  // has W = det(n_a, n_b, n_c) in intervals: positive there is the test passed.
+  const auto oriented = [&](int t) {
+    if (!s.has_vertex.empty() && s.has_vertex[t]) {
+      const HVertex& v = s.vertex[t];
+      if (v.known < 0 && v.planes == s.corner[t] && v.Wi.inf() > 0) return true;
+    }
+    return det_sign(planes[s.corner[t][0]], planes[s.corner[t][1]], planes[s.corner[t][2]]) > 0;
+  };
   std::atomic<bool> ok = true;
   parallel_chunks(nt, 512, [&](int begin, int end) {
     RoundingGuard guard;
     for (int t = begin; t < end && ok; ++t)
-      if (det_sign(planes[s.corner[t][0]], planes[s.corner[t][1]], planes[s.corner[t][2]]) <= 0)
-        ok = false;
+      if (!oriented(t)) ok = false;
   });
   if (!ok) return std::nullopt;
   // A ray from o crosses exactly one triangle: through the inside of triangle 0, and
@@ -1326,6 +1355,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     for (int j = begin; j < end && ok; ++j) {
       const int i = others[j];
       const Plane& p = planes[i];
+      if (!s.near.empty() && s.near[i] >= 0) u = group[s.near[i]];
       if (!known.empty())
         for (int k = known.begin[others[j]]; k < known.begin[others[j] + 1]; ++k)
           if (vertex_at_point[known.point[k]] >= 0) {
