@@ -638,6 +638,28 @@ TEST_CASE("halfspace_intersection: an erosion's wrong guess is rejected") {
   REQUIRE(sliver.polytope);
   CHECK(sliver.route == HullRoute::repaired);
   CHECK(sliver.polytope->num_vertices() == 8);  // a cube: the sliver is gone
+  // A sliver 2^-20 thin (the thinnest the operand checks take), scaled by 2^+-200 and far
+  // from the origin: repaired alike.
+  {
+    std::vector<morph::Point> thin(corners.begin(), corners.end() - 3);
+    const double cut = 1 - 0x1p-20;
+    thin.push_back({cut, 1, 1});
+    thin.push_back({1, cut, 1});
+    thin.push_back({1, 1, cut});
+    const morph::Mesh a = morph::test::convex_hull_mesh(thin), b = morph::test::octahedron(0.25);
+    const std::pair<morph::Mesh, morph::Mesh> cases[] = {
+        {a, b},
+        {morph::test::scaled(a, 0x1p200), morph::test::scaled(b, 0x1p200)},
+        {morph::test::scaled(a, 0x1p-200), morph::test::scaled(b, 0x1p-200)},
+        {morph::test::translated(a, {1e6, -3e5, 7e5}), b},
+    };
+    for (const auto& [ma, mb] : cases) {
+      const MaybePolytope r = eroded_three_ways(make_operand(ma, "A"), make_operand(mb, "B"));
+      REQUIRE(r.polytope);
+      CHECK(r.route == HullRoute::repaired);
+      CHECK(r.polytope->num_vertices() == 8);
+    }
+  }
   // A cone's apex of degree 256 opens up into many vertices: the flips give up after 4 per
   // corner (the hull is then cheaper); either way the result is the hull's.
   std::vector<morph::Point> cone{{0, 0, 1}};
