@@ -189,6 +189,11 @@ struct DualSurface {
   // Empty, or per plane: a triangle near the plane's dual point, for one that is not on the
   // surface (removed by a repair), where the check's climb starts; -1 where none is known.
   std::vector<int> near;
+  // Set by a repair: every triangle is known positively oriented, and far_side (3 per
+  // triangle: the check's far-plane signs, or 2 where not known) holds those of the
+  // triangles it left, with the same neighbours.
+  bool oriented = false;
+  std::vector<signed char> far_side;
 };
 
 /// The triangles of a hull computed by CGAL; empty when it is not a closed triangulated
@@ -372,12 +377,17 @@ PrecisePlane precise_plane(const Plane& plane) {
 V3<DD> normal_dd(const PrecisePlane& p) { return {p.c[0], p.c[1], p.c[2]}; }
 V3<Magnitude> normal_magnitude(const PrecisePlane& p) { return magnitude(normal_dd(p)); }
 
+/// n x m in double-double, its operations inlined (these run for most vertices; the
+/// arithmetic is exact.h's, so are the results and bounds).
+[[gnu::flatten]] V3<DD> cross_dd(const V3<DD>& n, const V3<DD>& m) { return cross(n, m); }
+
 /// The precise meet of valid planes a, b, c (round-to-nearest) from their normals' cross
 /// products bc, ca, ab in double-double, each as `cross` evaluates it or that negated (the
 /// same value of the opposite edge, n_b x n_a = -(n_a x n_b): negation is exact, so the
 /// bound below holds alike).
-void precise_meet(const PrecisePlane& a, const PrecisePlane& b, const PrecisePlane& c,
-                  const V3<DD>& bc, const V3<DD>& ca, const V3<DD>& ab, HVertex& v) {
+[[gnu::flatten]] void precise_meet(const PrecisePlane& a, const PrecisePlane& b,
+                                   const PrecisePlane& c, const V3<DD>& bc, const V3<DD>& ca,
+                                   const V3<DD>& ab, HVertex& v) {
   meet_of_crosses(normal_dd(a), a.c[3], b.c[3], c.c[3], bc, ca, ab, v.px, v.pw);
   V3<Magnitude> mx;
   Magnitude mw;
@@ -458,11 +468,11 @@ void make_precise(const PrecisePlanes& planes, HVertex& v,
     return;
   }
   const V3<DD> na = normal_dd(a), nb = normal_dd(b), nc = normal_dd(c);
-  precise_meet(a, b, c, cross(nb, nc), cross(nc, na), cross(na, nb), v);
+  precise_meet(a, b, c, cross_dd(nb, nc), cross_dd(nc, na), cross_dd(na, nb), v);
 }
 
 /// Sign of <n, X> - d W from the precise stage, or 2 (round-to-nearest; both precise).
-int precise_side(const PrecisePlane& p, const HVertex& v) {
+[[gnu::flatten]] int precise_side(const PrecisePlane& p, const HVertex& v) {
   const DD value = dot(normal_dd(p), v.px) - p.c[3] * v.pw;
   const V3<Magnitude> n = normal_magnitude(p);
   const Magnitude m = dot(n, magnitude(v.px)) - magnitude(p.c[3]) * magnitude(v.pw);
@@ -476,7 +486,7 @@ int precise_side(const PrecisePlane& p, const HVertex& v) {
 
 /// Sign of <n, Xu> Wv - <n, Xv> Wu from the precise stage, or 2 (round-to-nearest; all
 /// precise). Each vertex's own factor is positive, so the sign is that of <n, u - v>.
-int precise_compare(const PrecisePlane& p, const HVertex& u, const HVertex& v) {
+[[gnu::flatten]] int precise_compare(const PrecisePlane& p, const HVertex& u, const HVertex& v) {
   const V3<DD> n = normal_dd(p);
   const DD value = dot(n, u.px) * v.pw - dot(n, v.px) * u.pw;
   const V3<Magnitude> nm = normal_magnitude(p);
@@ -576,7 +586,7 @@ double step_away(double r, bool away) {
 /// lies strictly between two rounding midpoints (round-to-nearest); false otherwise (too
 /// close to a midpoint, or out of range): the exact rounding decides. X is within ex of
 /// the exact X, W within ew (both times the vertex's factor).
-bool round_precise(const DD& X, double ex, const DD& W, double ew, double& out) {
+[[gnu::flatten]] bool round_precise(const DD& X, double ex, const DD& W, double ew, double& out) {
   if (!(W.hi >= 0x1p-300 && W.hi <= 0x1p300) || !(ew <= 0x1p-60 * W.hi)) return false;
   // The residual R = X - r W in double-double: the product r W.hi is exact (Dekker), and
   // so is the cancelling X.hi - p.hi; what remains is small. `sum` bounds those small
@@ -886,7 +896,7 @@ bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& preci
                     const std::vector<std::pair<int, int>>& reflex) {
   RoundingGuard guard;
   const int nt = static_cast<int>(s.corner.size());
-  std::vector<char> dead(nt, 0);
+  std::vector<char> dead(nt, 0), changed(nt, 0);
   const auto next = [](int k) { return k == 2 ? 0 : k + 1; };
   const auto prev = [](int k) { return k == 0 ? 2 : k - 1; };
   const auto slot_of = [&](int t, int a) {
@@ -948,6 +958,7 @@ bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& preci
     if (!positive(y, z, d)) return false;
     if (!relink(Z, d, z, t) || !relink(Y, y, d, t)) return false;
     s.near[x] = t;  // x's dual point lies beneath t
+    changed[t] = 1;
     s.corner[t] = {y, z, d};
     s.across[t] = {X, Z, Y};
     s.has_vertex[t] = 0;
@@ -993,6 +1004,7 @@ bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& preci
       s.corner[u] = {d, c, b};
       s.across[u] = {Y2, X1, t};
       s.has_vertex[t] = s.has_vertex[u] = 0;
+      changed[t] = changed[u] = 1;
       queue.push_back({t, b, a});
       queue.push_back({u, c, b});
       queue.push_back({u, d, c});
@@ -1017,6 +1029,14 @@ bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& preci
     if (t >= 0 && dead[t]) t = s.across[t][0];
     if (t >= 0) t = index[t];
   }
+  // The far-plane signs stay for the edges between unchanged triangles.
+  std::vector<signed char> far_side(3 * static_cast<std::size_t>(kept), 2);
+  for (int t = 0; t < nt; ++t)
+    if (!dead[t] && !changed[t])
+      for (int k = 0; k < 3; ++k)
+        if (!changed[s.across[t][k]]) far_side[3 * index[t] + k] = s.far_side[3 * t + k];
+  s.far_side = std::move(far_side);
+  s.oriented = true;
   for (int t = 0; t < nt; ++t) {
     if (dead[t]) continue;
     const int r = index[t];
@@ -1063,7 +1083,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     return det_sign(planes[s.corner[t][0]], planes[s.corner[t][1]], planes[s.corner[t][2]]) > 0;
   };
   std::atomic<bool> ok = true;
-  parallel_chunks(nt, 512, [&](int begin, int end) {
+  parallel_chunks(s.oriented ? 0 : nt, 512, [&](int begin, int end) {
     RoundingGuard guard;
     for (int t = begin; t < end && ok; ++t)
       if (!oriented(t)) ok = false;
@@ -1121,6 +1141,13 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     RoundingGuard guard;
     HVertex local;
     for (int t = begin; t < end && ok; ++t) {
+      if (!s.far_side.empty() && s.far_side[3 * t] != 2 && s.far_side[3 * t + 1] != 2 &&
+          s.far_side[3 * t + 2] != 2) {
+        // (Its vertex is stored: a triangle the repair left.)
+        for (int k = 0; k < 3; ++k)
+          if ((far_side[3 * t + k] = s.far_side[3 * t + k]) > 0) ok = false;
+        continue;
+      }
       HVertex& v = stored ? s.vertex[t] : local;
       if (!stored) {
         // A polygon's triangles come in a row and, in a closing, share one known point: the
@@ -1161,6 +1188,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     for (int t = 0; t < nt; ++t)
       for (int k = 0; k < 3; ++k)
         if (far_side[3 * t + k] > 0) edges.emplace_back(t, k);
+    s.far_side = std::move(far_side);
     if (!repair_surface(planes, precise, known, s, edges)) return std::nullopt;
     *repaired = true;
     return build_verified(hs, planes, precise, known, std::move(s), options);
@@ -1291,8 +1319,8 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       if (!from_planes[t]) continue;
       for (int k = 0; k < 3; ++k)
         if (!shared(t, k))
-          edge_cross[3 * t + k] = cross(normal_dd(precise[s.corner[t][k]]),
-                                        normal_dd(precise[s.corner[t][k == 2 ? 0 : k + 1]]));
+          edge_cross[3 * t + k] = cross_dd(normal_dd(precise[s.corner[t][k]]),
+                                           normal_dd(precise[s.corner[t][k == 2 ? 0 : k + 1]]));
     }
   });
   parallel_chunks(nv, 128, [&](int begin, int end) {
@@ -1316,7 +1344,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
             const V3<DD>& c = edge_cross[3 * u + j];
             along[k] = {-c.x, -c.y, -c.z};
           } else {
-            along[k] = cross(normal_dd(precise[a]), normal_dd(precise[b]));
+            along[k] = cross_dd(normal_dd(precise[a]), normal_dd(precise[b]));
           }
         }
         const std::array<V3<DD>, 3> crosses{along[1], along[2], along[0]};
