@@ -992,8 +992,10 @@ bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& preci
     if (--budget < 0) return false;
     const int X1 = s.across[t][next(i)], X2 = s.across[t][prev(i)], Y1 = s.across[u][next(j)],
               Y2 = s.across[u][prev(j)];
+    // (A fan too long to follow counts as joined: no flip that could double an edge.)
     bool joined = b == d;
-    if (!joined) around(t, b, kMaxDegree, [&](int w) { joined = joined || w == d; });
+    if (!joined && around(t, b, kMaxDegree, [&](int w) { joined = joined || w == d; }) > kMaxDegree)
+      joined = true;
     bool outer_ok = true;
     for (int o : {X1, X2, Y1, Y2})
       if (o == t || o == u) outer_ok = false;
