@@ -18,7 +18,7 @@
 // by one vertex of B) make vertices without exact constructions and zero tests free, and
 // an expected result (ExpectedVertices: A's vertices, opened up by exact flips where the
 // moved planes around one no longer meet in a point; a closing's A) replaces the hull when it
-// passes the check.
+// passes the check, or, when only some of its edges fail, once flips have repaired those.
 #include "halfspace_intersection.h"
 
 #include <CGAL/Lazy_kernel.h>
@@ -76,6 +76,13 @@ struct Plane {
   const HalfSpace* source = nullptr;  // its normal's double-double copy, when it has one
 };
 
+/// The interval of a component in double-double within 2^-101 of its |hi| (as
+/// HalfSpace::normal_dd; needs a RoundingGuard: the bound rounds up).
+Interval dd_interval(const DD& c) {
+  const double e = 0x1p-101 * std::abs(c.hi);
+  return Interval(c.hi) + Interval(c.lo) + Interval(-e, e);
+}
+
 std::vector<Plane> planes_of(const std::vector<HalfSpace>& hs) {
   std::vector<Plane> planes(hs.size());
   parallel_chunks(static_cast<int>(hs.size()), 256, [&](int begin, int end) {
@@ -86,8 +93,14 @@ std::vector<Plane> planes_of(const std::vector<HalfSpace>& hs) {
       p.n = q == 1 ? hs[i].normal
                    : V3<ExactN>{hs[i].normal.x * q, hs[i].normal.y * q, hs[i].normal.z * q};
       p.d = hs[i].offset;
-      if (q == 1 && hs[i].has_normal_dd) p.source = &hs[i];
-      p.ni = to_interval_n(p.n);
+      if (q == 1 && hs[i].has_normal_dd) {
+        // The normal's enclosure from its double-double copy (cheaper than from Mpzf).
+        p.source = &hs[i];
+        const auto& c = hs[i].normal_dd;
+        p.ni = {dd_interval(c[0]), dd_interval(c[1]), dd_interval(c[2])};
+      } else {
+        p.ni = to_interval_n(p.n);
+      }
       p.di = to_interval_n(p.d);
     }
   });
@@ -173,6 +186,14 @@ struct DualSurface {
   std::vector<std::array<int, 3>> across;
   std::vector<HVertex> vertex;  // empty, or one per triangle
   std::vector<char> has_vertex;
+  // Empty, or per plane: a triangle near the plane's dual point, for one that is not on the
+  // surface (removed by a repair), where the check's climb starts; -1 where none is known.
+  std::vector<int> near;
+  // Set by a repair: every triangle is known positively oriented, and far_side (3 per
+  // triangle: the check's far-plane signs, or 2 where not known) holds those of the
+  // triangles it left, with the same neighbours.
+  bool oriented = false;
+  std::vector<signed char> far_side;
 };
 
 /// The triangles of a hull computed by CGAL; empty when it is not a closed triangulated
@@ -356,12 +377,17 @@ PrecisePlane precise_plane(const Plane& plane) {
 V3<DD> normal_dd(const PrecisePlane& p) { return {p.c[0], p.c[1], p.c[2]}; }
 V3<Magnitude> normal_magnitude(const PrecisePlane& p) { return magnitude(normal_dd(p)); }
 
+/// n x m in double-double, its operations inlined (these run for most vertices; the
+/// arithmetic is exact.h's, so are the results and bounds).
+[[gnu::flatten]] V3<DD> cross_dd(const V3<DD>& n, const V3<DD>& m) { return cross(n, m); }
+
 /// The precise meet of valid planes a, b, c (round-to-nearest) from their normals' cross
 /// products bc, ca, ab in double-double, each as `cross` evaluates it or that negated (the
 /// same value of the opposite edge, n_b x n_a = -(n_a x n_b): negation is exact, so the
 /// bound below holds alike).
-void precise_meet(const PrecisePlane& a, const PrecisePlane& b, const PrecisePlane& c,
-                  const V3<DD>& bc, const V3<DD>& ca, const V3<DD>& ab, HVertex& v) {
+[[gnu::flatten]] void precise_meet(const PrecisePlane& a, const PrecisePlane& b,
+                                   const PrecisePlane& c, const V3<DD>& bc, const V3<DD>& ca,
+                                   const V3<DD>& ab, HVertex& v) {
   meet_of_crosses(normal_dd(a), a.c[3], b.c[3], c.c[3], bc, ca, ab, v.px, v.pw);
   V3<Magnitude> mx;
   Magnitude mw;
@@ -442,11 +468,11 @@ void make_precise(const PrecisePlanes& planes, HVertex& v,
     return;
   }
   const V3<DD> na = normal_dd(a), nb = normal_dd(b), nc = normal_dd(c);
-  precise_meet(a, b, c, cross(nb, nc), cross(nc, na), cross(na, nb), v);
+  precise_meet(a, b, c, cross_dd(nb, nc), cross_dd(nc, na), cross_dd(na, nb), v);
 }
 
 /// Sign of <n, X> - d W from the precise stage, or 2 (round-to-nearest; both precise).
-int precise_side(const PrecisePlane& p, const HVertex& v) {
+[[gnu::flatten]] int precise_side(const PrecisePlane& p, const HVertex& v) {
   const DD value = dot(normal_dd(p), v.px) - p.c[3] * v.pw;
   const V3<Magnitude> n = normal_magnitude(p);
   const Magnitude m = dot(n, magnitude(v.px)) - magnitude(p.c[3]) * magnitude(v.pw);
@@ -460,7 +486,7 @@ int precise_side(const PrecisePlane& p, const HVertex& v) {
 
 /// Sign of <n, Xu> Wv - <n, Xv> Wu from the precise stage, or 2 (round-to-nearest; all
 /// precise). Each vertex's own factor is positive, so the sign is that of <n, u - v>.
-int precise_compare(const PrecisePlane& p, const HVertex& u, const HVertex& v) {
+[[gnu::flatten]] int precise_compare(const PrecisePlane& p, const HVertex& u, const HVertex& v) {
   const V3<DD> n = normal_dd(p);
   const DD value = dot(n, u.px) * v.pw - dot(n, v.px) * u.pw;
   const V3<Magnitude> nm = normal_magnitude(p);
@@ -560,7 +586,7 @@ double step_away(double r, bool away) {
 /// lies strictly between two rounding midpoints (round-to-nearest); false otherwise (too
 /// close to a midpoint, or out of range): the exact rounding decides. X is within ex of
 /// the exact X, W within ew (both times the vertex's factor).
-bool round_precise(const DD& X, double ex, const DD& W, double ew, double& out) {
+[[gnu::flatten]] bool round_precise(const DD& X, double ex, const DD& W, double ew, double& out) {
   if (!(W.hi >= 0x1p-300 && W.hi <= 0x1p300) || !(ew <= 0x1p-60 * W.hi)) return false;
   // The residual R = X - r W in double-double: the product r W.hi is exact (Dekker), and
   // so is the cancelling X.hi - p.hi; what remains is small. `sum` bounds those small
@@ -845,27 +871,224 @@ Polytope verified_polytope(std::vector<V3<double>> points, ExactPoints exact,
   return p;
 }
 
+/// Actions (flips and removals) per triangle after which a repair gives up: a guess that
+/// needs more is far from the result, and the hull is then the cheaper route.
+constexpr int kRepairsPerTriangle = 1;
+
+/// Repairs a candidate dual surface (closed, oriented, every triangle positively oriented
+/// about o) whose edges `reflex` (triangle, edge) are not locally convex: the far corner d
+/// of the triangle across edge a -> c of triangle (a, c, b) cuts off that triangle's
+/// vertex (side > 0, exactly). Such an edge is flipped to (b, d) when both new triangles
+/// are positively oriented and b, d are not joined yet (a 2-2 flip: the enclosed region
+/// grows by the tetrahedron a, b, c, d); otherwise an end of the edge with three
+/// neighbours is removed (a 3-1 flip: its dual point is beneath the triangle of its
+/// neighbours, the same four points; its plane does not bound the intersection), when that
+/// triangle is positively oriented. Each action is followed by the tests of the edges
+/// around it; an edge that neither action can repair yet waits until others have acted.
+/// Every triangle made keeps det > 0, so the repaired surface still winds once around o.
+/// Lawson's flips for a convex hull need not finish (a reflex edge may have no valid
+/// action): false then, or after kRepairsPerTriangle actions per triangle, and the hull
+/// is computed. The result is checked exactly like any candidate (build_verified), so the
+/// repair only has to be right where it acts, not complete.
+/// Triangles removed are dropped from `s`; triangles changed have no vertex (has_vertex).
+bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& precise,
+                    const KnownPoints& known, DualSurface& s,
+                    const std::vector<std::pair<int, int>>& reflex) {
+  RoundingGuard guard;
+  const int nt = static_cast<int>(s.corner.size());
+  std::vector<char> dead(nt, 0), changed(nt, 0);
+  const auto next = [](int k) { return k == 2 ? 0 : k + 1; };
+  const auto prev = [](int k) { return k == 0 ? 2 : k - 1; };
+  const auto slot_of = [&](int t, int a) {
+    for (int k = 0; k < 3; ++k)
+      if (s.corner[t][k] == a) return k;
+    return -1;
+  };
+  const auto vertex_at = [&](int t) -> HVertex& {
+    if (!s.has_vertex[t]) {
+      s.vertex[t] = independent_vertex_of(planes, s.corner[t], known);
+      s.has_vertex[t] = 1;
+    }
+    return s.vertex[t];
+  };
+  const auto positive = [&](int a, int b, int c) {
+    return det_sign(planes[a], planes[b], planes[c]) > 0;
+  };
+  // Sets the across of triangle t's edge x -> y to `to`; false when t has no such edge.
+  const auto relink = [&](int t, int x, int y, int to) {
+    const int k = slot_of(t, x);
+    if (k < 0 || s.corner[t][next(k)] != y) return false;
+    s.across[t][k] = to;
+    return true;
+  };
+  // The triangles around corner a of triangle t, up to `limit` + 1 (the fan is followed
+  // through the triangle across each edge leaving a); `visit` sees each one's other
+  // corner along that edge.
+  const auto around = [&](int t, int a, int limit, const auto& visit) {
+    int count = 0, u = t;
+    do {
+      const int k = slot_of(u, a);
+      if (k < 0 || ++count > limit) return limit + 1;
+      visit(s.corner[u][next(k)]);
+      u = s.across[u][k];
+    } while (u != t);
+    return count;
+  };
+  constexpr int kMaxDegree = 1 << 12;
+  s.near.assign(planes.size(), -1);
+  std::vector<std::array<int, 3>> queue, waiting;  // (t, a, c): the edge a -> c of t
+  for (auto it = reflex.rbegin(); it != reflex.rend(); ++it)
+    queue.push_back(
+        {it->first, s.corner[it->first][it->second], s.corner[it->first][next(it->second)]});
+  const auto push_edges = [&](int t) {
+    for (int k = 2; k >= 0; --k) queue.push_back({t, s.corner[t][k], s.corner[t][next(k)]});
+  };
+  // Removes corner slot i of triangle t when it has three neighbours: t = (x, y, z),
+  // u = (y, x, d) across x -> y, w = (x, z, d) across z -> x become (y, z, d) in t.
+  const auto remove = [&](int t, int i) {
+    const int x = s.corner[t][i], y = s.corner[t][next(i)], z = s.corner[t][prev(i)];
+    const int u = s.across[t][i], w = s.across[t][prev(i)];
+    const int jx = slot_of(u, x), mx = slot_of(w, x);
+    if (u == w || jx < 0 || mx < 0) return false;
+    const int d = s.corner[u][next(jx)];
+    if (s.corner[w][prev(mx)] != d || s.across[u][jx] != w) return false;  // degree > 3
+    const int Y = s.across[u][next(jx)], Z = s.across[w][next(mx)], X = s.across[t][next(i)];
+    for (int o : {X, Y, Z})
+      if (o == t || o == u || o == w) return false;
+    if (!positive(y, z, d)) return false;
+    if (!relink(Z, d, z, t) || !relink(Y, y, d, t)) return false;
+    s.near[x] = t;  // x's dual point lies beneath t
+    changed[t] = 1;
+    s.corner[t] = {y, z, d};
+    s.across[t] = {X, Z, Y};
+    s.has_vertex[t] = 0;
+    dead[u] = dead[w] = 1;
+    push_edges(t);
+    return true;
+  };
+  int budget = kRepairsPerTriangle * nt + 16;
+  bool progress = false;
+  while (true) {
+    if (queue.empty()) {
+      if (waiting.empty()) break;
+      if (!progress) return false;
+      progress = false;
+      std::swap(queue, waiting);
+      std::reverse(queue.begin(), queue.end());
+      continue;
+    }
+    const auto [t, a, c] = queue.back();
+    queue.pop_back();
+    if (dead[t]) continue;
+    const int i = slot_of(t, a);
+    if (i < 0 || s.corner[t][next(i)] != c) continue;  // changed meanwhile
+    const int u = s.across[t][i], j = slot_of(u, c);
+    if (j < 0 || s.corner[u][next(j)] != a) return false;  // not a closed oriented surface
+    const int b = s.corner[t][prev(i)], d = s.corner[u][prev(j)];
+    HVertex& v = vertex_at(t);
+    // (W > 0: a known point, or the meet of positively oriented planes; independent_vertex_of
+    // and the checks' side tests assume the same.)
+    if (known_through(known, d, v) || side(planes, precise, d, v) <= 0) continue;
+    if (--budget < 0) return false;
+    const int X1 = s.across[t][next(i)], X2 = s.across[t][prev(i)], Y1 = s.across[u][next(j)],
+              Y2 = s.across[u][prev(j)];
+    // (A fan too long to follow counts as joined: no flip that could double an edge.)
+    bool joined = b == d;
+    if (!joined && around(t, b, kMaxDegree, [&](int w) { joined = joined || w == d; }) > kMaxDegree)
+      joined = true;
+    bool outer_ok = true;
+    for (int o : {X1, X2, Y1, Y2})
+      if (o == t || o == u) outer_ok = false;
+    if (!joined && outer_ok && positive(a, d, b) && positive(d, c, b)) {
+      if (!relink(Y1, d, a, t) || !relink(X1, b, c, u)) return false;
+      s.corner[t] = {a, d, b};
+      s.across[t] = {Y1, u, X2};
+      s.corner[u] = {d, c, b};
+      s.across[u] = {Y2, X1, t};
+      s.has_vertex[t] = s.has_vertex[u] = 0;
+      changed[t] = changed[u] = 1;
+      queue.push_back({t, b, a});
+      queue.push_back({u, c, b});
+      queue.push_back({u, d, c});
+      queue.push_back({t, a, d});
+      progress = true;
+      continue;
+    }
+    if (remove(t, i) || remove(t, next(i))) {
+      progress = true;
+      continue;
+    }
+    ++budget;
+    waiting.push_back({t, a, c});
+  }
+  // Drop the removed triangles.
+  std::vector<int> index(nt, -1);
+  int kept = 0;
+  for (int t = 0; t < nt; ++t)
+    if (!dead[t]) index[t] = kept++;
+  for (int& t : s.near) {
+    // (A triangle removed since: its dual point's neighbour, still near.)
+    if (t >= 0 && dead[t]) t = s.across[t][0];
+    if (t >= 0) t = index[t];
+  }
+  // The far-plane signs stay for the edges between unchanged triangles.
+  std::vector<signed char> far_side(3 * static_cast<std::size_t>(kept), 2);
+  for (int t = 0; t < nt; ++t)
+    if (!dead[t] && !changed[t])
+      for (int k = 0; k < 3; ++k)
+        if (!changed[s.across[t][k]]) far_side[3 * index[t] + k] = s.far_side[3 * t + k];
+  s.far_side = std::move(far_side);
+  s.oriented = true;
+  for (int t = 0; t < nt; ++t) {
+    if (dead[t]) continue;
+    const int r = index[t];
+    s.corner[r] = s.corner[t];
+    s.across[r] = {index[s.across[t][0]], index[s.across[t][1]], index[s.across[t][2]]};
+    if (r != t) s.vertex[r] = std::move(s.vertex[t]);
+    s.has_vertex[r] = s.has_vertex[t];
+  }
+  s.corner.resize(kept);
+  s.across.resize(kept);
+  s.vertex.resize(kept);
+  s.has_vertex.resize(kept);
+  for (const auto& a : s.across)
+    for (int x : a)
+      if (x < 0) return false;
+  return kept >= 4;
+}
+
 /// Builds the intersection from a candidate dual hull, checking exactly that it is the
 /// dual hull of all the planes; nullopt when it is not. The result has `rounded`, and
 /// `polytope` when options.polytope (its exact points computed up front when
 /// options.eager_exact, else on demand: polytope_points).
+/// `repaired`, when not null (a guess, with its triangles' vertices), allows edges that are
+/// not locally convex to be repaired (repair_surface) and the result checked again; it
+/// tells whether that happened.
 std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
                                             const std::vector<Plane>& planes,
-                                            const PrecisePlanes& precise,
-                                            const KnownPoints& known, DualSurface s,
-                                            const IntersectOptions& options) {
+                                            const PrecisePlanes& precise, const KnownPoints& known,
+                                            DualSurface s, const IntersectOptions& options,
+                                            bool* repaired = nullptr) {
   const bool with_polytope = options.polytope;
   const int nt = static_cast<int>(s.corner.size());
   const int n = static_cast<int>(planes.size());
   if (nt == 0) return std::nullopt;
   // Every triangle sees o on its inner side: det(n_a, n_b, n_c) > 0 (dual points are the
   // normals scaled by positive factors).
+  // A vertex the candidate computed from its corners' planes, in order (not a known point),
+  // has W = det(n_a, n_b, n_c) in intervals: positive there is the test passed.
+  const auto oriented = [&](int t) {
+    if (!s.has_vertex.empty() && s.has_vertex[t]) {
+      const HVertex& v = s.vertex[t];
+      if (v.known < 0 && v.planes == s.corner[t] && v.Wi.inf() > 0) return true;
+    }
+    return det_sign(planes[s.corner[t][0]], planes[s.corner[t][1]], planes[s.corner[t][2]]) > 0;
+  };
   std::atomic<bool> ok = true;
-  parallel_chunks(nt, 512, [&](int begin, int end) {
+  parallel_chunks(s.oriented ? 0 : nt, 512, [&](int begin, int end) {
     RoundingGuard guard;
     for (int t = begin; t < end && ok; ++t)
-      if (det_sign(planes[s.corner[t][0]], planes[s.corner[t][1]], planes[s.corner[t][2]]) <= 0)
-        ok = false;
+      if (!oriented(t)) ok = false;
   });
   if (!ok) return std::nullopt;
   // A ray from o crosses exactly one triangle: through the inside of triangle 0, and
@@ -913,11 +1136,20 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   // and the signs are the group's. A surface without vertices gets none stored (large,
   // and most would be dropped): each is made for its tests, and the seeds' again below.
   const bool stored = !s.vertex.empty();
+  const bool can_repair = repaired && stored;
+  std::atomic<bool> reflex = false;  // an edge to repair
   std::vector<signed char> far_side(3 * static_cast<std::size_t>(nt));
   parallel_chunks(nt, 256, [&](int begin, int end) {
     RoundingGuard guard;
     HVertex local;
     for (int t = begin; t < end && ok; ++t) {
+      if (!s.far_side.empty() && s.far_side[3 * t] != 2 && s.far_side[3 * t + 1] != 2 &&
+          s.far_side[3 * t + 2] != 2) {
+        // (Its vertex is stored: a triangle the repair left.)
+        for (int k = 0; k < 3; ++k)
+          if ((far_side[3 * t + k] = s.far_side[3 * t + k]) > 0) ok = false;
+        continue;
+      }
       HVertex& v = stored ? s.vertex[t] : local;
       if (!stored) {
         // A polygon's triangles come in a row and, in a closing, share one known point: the
@@ -940,12 +1172,29 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
         const int sd = far < 0                        ? 1
                        : known_through(known, far, v) ? 0
                                                       : side(planes, precise, far, v);
-        if (sd > 0) ok = false;
+        if (sd > 0) {
+          if (can_repair)
+            reflex = true;
+          else
+            ok = false;
+        }
         far_side[3 * t + k] = static_cast<signed char>(sd);
       }
     }
   });
   if (!ok) return std::nullopt;
+  if (reflex) {
+    // Every triangle's vertex is computed now (stored): the repair keeps those it leaves.
+    std::fill(s.has_vertex.begin(), s.has_vertex.end(), 1);
+    std::vector<std::pair<int, int>> edges;
+    for (int t = 0; t < nt; ++t)
+      for (int k = 0; k < 3; ++k)
+        if (far_side[3 * t + k] > 0) edges.emplace_back(t, k);
+    s.far_side = std::move(far_side);
+    if (!repair_surface(planes, precise, known, s, edges)) return std::nullopt;
+    *repaired = true;
+    return build_verified(hs, planes, precise, known, std::move(s), options);
+  }
   std::vector<int> group(nt, -1), seed;
   {
     std::vector<int> stack;
@@ -1072,8 +1321,8 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       if (!from_planes[t]) continue;
       for (int k = 0; k < 3; ++k)
         if (!shared(t, k))
-          edge_cross[3 * t + k] = cross(normal_dd(precise[s.corner[t][k]]),
-                                        normal_dd(precise[s.corner[t][k == 2 ? 0 : k + 1]]));
+          edge_cross[3 * t + k] = cross_dd(normal_dd(precise[s.corner[t][k]]),
+                                           normal_dd(precise[s.corner[t][k == 2 ? 0 : k + 1]]));
     }
   });
   parallel_chunks(nv, 128, [&](int begin, int end) {
@@ -1097,7 +1346,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
             const V3<DD>& c = edge_cross[3 * u + j];
             along[k] = {-c.x, -c.y, -c.z};
           } else {
-            along[k] = cross(normal_dd(precise[a]), normal_dd(precise[b]));
+            along[k] = cross_dd(normal_dd(precise[a]), normal_dd(precise[b]));
           }
         }
         const std::array<V3<DD>, 3> crosses{along[1], along[2], along[0]};
@@ -1136,6 +1385,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     for (int j = begin; j < end && ok; ++j) {
       const int i = others[j];
       const Plane& p = planes[i];
+      if (!s.near.empty() && s.near[i] >= 0) u = group[s.near[i]];
       if (!known.empty())
         for (int k = known.begin[others[j]]; k < known.begin[others[j] + 1]; ++k)
           if (vertex_at_point[known.point[k]] >= 0) {
@@ -1779,10 +2029,6 @@ struct PolygonScratch {
 /// take O(k^2) on a vertex of A of high degree, and the hull is then the cheaper route.
 constexpr int kFlipsPerCorner = 4;
 
-/// Polygons of more planes than this are triangulated first, and tested against the planes
-/// nearby (expected_surface).
-constexpr int kLargePolygon = 8;
-
 /// Triangulates the polygon of planes p[0 .. k) (counter-clockwise seen from outside) so
 /// that it is locally convex, as the dual hull is: Lawson flips from a fan. The diagonal
 /// (a, c) between triangles (a, c, b) and (c, a, d) is flipped to (b, d) when plane d cuts
@@ -1920,65 +2166,10 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const PrecisePlan
                              expected.split ? &s.has_vertex[first[v]] : nullptr, scratch))
       ok = false;
   };
-  // Polygons of many planes first, each with a test that rejects a doomed guess early: where
-  // facets of A vanish (the thin facets around the pole of a UV sphere), a vertex of such a
-  // polygon's triangles is cut off by a plane of a polygon nearby. The planes of the polygons
-  // that share a plane with it are tested at its triangles' vertices; one that cuts a vertex
-  // off (side > 0, exactly) proves the guess wrong (a right one has every triangle's vertex
-  // a vertex of the intersection, inside every half-space), and the hull is computed without
-  // triangulating the rest. Each polygon's triangles do not depend on the order.
-  const auto size = [&](int v) { return expected.begin[v + 1] - expected.begin[v]; };
-  std::vector<int> large_polygons;
-  if (expected.split)
-    for (int v = 0; v < nv; ++v)
-      if (size(v) > kLargePolygon) large_polygons.push_back(v);
-  if (!large_polygons.empty()) {
-    // The polygons through each plane (a counting sort of the expected facets).
-    const int n = static_cast<int>(planes.size());
-    std::vector<int> through_begin(n + 1, 0), through(expected.facets.size());
-    for (int i : expected.facets) ++through_begin[i + 1];
-    std::partial_sum(through_begin.begin(), through_begin.end(), through_begin.begin());
-    {
-      std::vector<int> next(through_begin.begin(), through_begin.end() - 1);
-      for (int v = 0; v < nv; ++v)
-        for (int j = expected.begin[v]; j < expected.begin[v + 1]; ++j)
-          through[next[expected.facets[j]]++] = v;
-    }
-    parallel_chunks(static_cast<int>(large_polygons.size()), 1, [&](int begin, int end) {
-      RoundingGuard guard;
-      PolygonScratch scratch;
-      std::vector<int> nearby;
-      for (int j = begin; j < end && ok; ++j) {
-        const int v = large_polygons[j];
-        triangulate(v, scratch);
-        if (!ok) break;
-        const int* p = &expected.facets[expected.begin[v]];
-        nearby.clear();
-        for (int i = 0; i < size(v); ++i)
-          for (int w = through_begin[p[i]]; w < through_begin[p[i] + 1]; ++w)
-            for (int c = expected.begin[through[w]]; c < expected.begin[through[w] + 1]; ++c)
-              if (std::find(p, p + size(v), expected.facets[c]) == p + size(v))
-                nearby.push_back(expected.facets[c]);
-        std::sort(nearby.begin(), nearby.end());
-        nearby.erase(std::unique(nearby.begin(), nearby.end()), nearby.end());
-        for (int t = first[v]; t < first[v + 1] && ok; ++t) {
-          HVertex& x = s.vertex[t];
-          // (W > 0 for the sign below: a known point, or positive by intervals.)
-          if (!s.has_vertex[t] || (x.known < 0 && !(x.Wi.inf() > 0))) continue;
-          for (int i : nearby)
-            if (!known_through(known, i, x) && side(planes, precise, i, x) > 0) {
-              ok = false;
-              break;
-            }
-        }
-      }
-    });
-  }
   parallel_chunks(ok ? nv : 0, 64, [&](int begin, int end) {
     RoundingGuard guard;
     PolygonScratch scratch;
-    for (int v = begin; v < end && ok; ++v)
-      if (large_polygons.empty() || size(v) <= kLargePolygon) triangulate(v, scratch);
+    for (int v = begin; v < end && ok; ++v) triangulate(v, scratch);
   });
   if (!ok) return {};
   // Directed edges 3 t + k (corner k to k + 1 of triangle t) listed by their first plane
@@ -2045,9 +2236,11 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
   // the duality argument hold, so the rounded o only has to centre the virtual planes.
   const PrecisePlanes precise(planes);
   if (options.incremental && options.guess && !expected.empty()) {
+    bool repaired = false;
     if (auto built = build_verified(hs, planes, precise, known,
-                                    expected_surface(planes, precise, known, expected), options)) {
-      built->route = HullRoute::expected;
+                                    expected_surface(planes, precise, known, expected), options,
+                                    &repaired)) {
+      built->route = repaired ? HullRoute::repaired : HullRoute::expected;
       return std::move(*built);
     }
   }

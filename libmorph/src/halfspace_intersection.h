@@ -46,6 +46,7 @@ enum class HullRoute : unsigned char {
   incremental,  // the exact incremental hull on the planes, checked exactly
   exact,        // CGAL's hull of the exact dual points (its check failed, or it was not tried)
   expected,     // the caller's expected result (ExpectedVertices), checked exactly
+  repaired,     // that result with edges flipped where it was wrong, checked exactly
 };
 
 /// An intersection as it is written out: its vertices rounded to nearest (from their exact
@@ -115,8 +116,9 @@ struct KnownPoints {
 /// erosion is A with its facets moved in. The planes of a polygon may meet in several
 /// vertices (an erosion's facets around a vertex of A moved by different vertices of B):
 /// each polygon is triangulated to be locally convex, in parallel. Only a guess: it is
-/// checked exactly, as any candidate, and the hull is computed when the check fails (a
-/// facet that vanishes, an edge that collapses). Empty: none.
+/// checked exactly, as any candidate; where it is wrong (a facet that vanishes, an edge that
+/// collapses) it is repaired by flips and checked again, and the hull is computed when that
+/// fails. Empty: none.
 struct ExpectedVertices {
   std::vector<int> begin;  // size V + 1, or empty
   std::vector<int> facets;
