@@ -24,6 +24,7 @@ namespace {
 // that two threads share each loop evenly (a chunk is a few microseconds of work), large
 // enough that the walk's restart at a chunk's first facet costs little.
 constexpr int kFacetGrain = 128;
+constexpr int kHintedGrain = 64;  // walks from WalkStarts: no restart at a chunk
 constexpr int kEdgeGrain = 64;
 
 Element element_of(const Polytope& P, const Location& loc) {
@@ -64,16 +65,18 @@ struct ChunkLoop {
   std::vector<FacetBuffer>* out;
   int chunks() const { return (n + grain - 1) / grain; }
 };
+/// With one thread, one chunk per loop: fewer buffers to fill and gather.
 template <class Body>
 ChunkLoop<Body> chunk_loop(int n, int grain, const Body& body, std::vector<FacetBuffer>& out) {
-  return {n, grain, body, &out};
+  return {n, tbb::this_task_arena::max_concurrency() == 1 ? std::max(n, 1) : grain, body, &out};
 }
 
-/// Runs the chunks of both loops as one parallel loop (one join for both), each chunk
-/// writing its own buffer: the buffers are in loop order, whatever the schedule.
-template <class Body1, class Body2>
-void in_chunks(const ChunkLoop<Body1>& one, const ChunkLoop<Body2>& two) {
-  const int c1 = one.chunks(), c2 = two.chunks();
+/// Runs `task` (unless null) and the chunks of both loops as one parallel loop (one join
+/// for all), each chunk writing its own buffer: the buffers are in loop order, whatever
+/// the schedule.
+template <class Body1, class Body2, class Task>
+void in_chunks(const ChunkLoop<Body1>& one, const ChunkLoop<Body2>& two, const Task* task) {
+  const int t = task ? 1 : 0, c1 = one.chunks(), c2 = two.chunks();
   one.out->resize(c1);
   two.out->resize(c2);
   auto run = [](const auto& loop, int c, int& hint) {
@@ -84,16 +87,25 @@ void in_chunks(const ChunkLoop<Body1>& one, const ChunkLoop<Body2>& two) {
     b.corners.reserve(4 * loop.grain);
     loop.body(c * loop.grain, std::min(loop.n, (c + 1) * loop.grain), b, hint);
   };
-  parallel_chunks(c1 + c2, 1, [&](int first, int last) {
+  parallel_chunks(t + c1 + c2, 1, [&](int first, int last) {
     int hint = 0;
     for (int c = first; c < last; ++c) {
-      if (c == c1) hint = 0;  // the second loop walks on another map
-      if (c < c1)
-        run(one, c, hint);
-      else
-        run(two, c - c1, hint);
+      if (c < t)
+        (*task)();
+      else if (c < t + c1)
+        run(one, c - t, hint);
+      else {
+        if (c == t + c1) hint = 0;  // the second loop walks on another map
+        run(two, c - t - c1, hint);
+      }
     }
   });
+}
+template <class Body>
+void in_chunks(const ChunkLoop<Body>& one) {
+  std::vector<FacetBuffer> none;
+  const auto* no_task = static_cast<void (*const*)()>(nullptr);
+  in_chunks(one, chunk_loop(0, 1, one.body, none), no_task);
 }
 
 /// The facet of A (+) B whose normal is the normal of facet f of X (X is A when
@@ -361,23 +373,38 @@ std::vector<ArcPlane> slots_for(const Polytope& P, int walks) {
   return {};
 }
 
-/// The facets of the buffers, in order: sizes summed once, each array filled in one go.
-SumFacets gather(std::initializer_list<const std::vector<FacetBuffer>*> lists) {
+using BufferLists = std::initializer_list<const std::vector<FacetBuffer>*>;
+
+/// Appends the facets of the buffers to `out`, in order: sizes summed once, each array
+/// extended in one go.
+void append(SumFacets& out, BufferLists lists) {
   std::size_t faces = 0, corners = 0;
   for (const auto* list : lists)
     for (const auto& b : *list) faces += b.origins.size(), corners += b.corners.size();
-  SumFacets out;
-  out.face_begin.resize(faces + 1);
-  out.corners.reserve(corners);
-  out.origins.reserve(faces);
-  int* begin = out.face_begin.data();
+  const std::size_t done = out.origins.size();
+  out.face_begin.resize(done + faces + 1);
+  out.corners.reserve(out.corners.size() + corners);
+  out.origins.reserve(done + faces);
+  int* begin = out.face_begin.data() + done;
   for (const auto* list : lists)
     for (const auto& b : *list) {
       for (int size : b.sizes) begin[1] = begin[0] + size, ++begin;
       out.corners.insert(out.corners.end(), b.corners.begin(), b.corners.end());
       out.origins.insert(out.origins.end(), b.origins.begin(), b.origins.end());
     }
-  return out;
+}
+
+/// The first part of the facets, gathered while the last loop makes the rest: the arrays
+/// made with room for about `more_faces` more facets of four corners (they grow if that
+/// was too few), the buffers appended.
+void gather_head(SumFacets& out, BufferLists lists, std::size_t more_faces) {
+  std::size_t faces = 0, corners = 0;
+  for (const auto* list : lists)
+    for (const auto& b : *list) faces += b.origins.size(), corners += b.corners.size();
+  out.face_begin.reserve(faces + more_faces + 1);
+  out.corners.reserve(corners + 4 * more_faces);
+  out.origins.reserve(faces + more_faces);
+  append(out, lists);
 }
 
 }  // namespace
@@ -439,28 +466,32 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
       edge_facets(A, a, arc_plane(A, a), B, l, r, w, out);
     }
   };
-  auto nothing = [](int, int, FacetBuffer&, int&) {};
+  SumFacets out;
+  // Edge facets: usually about as many as the edges of both (one per crossing of arcs).
+  const std::size_t edge_estimate = A.num_edges() + B.num_edges();
   if (A.num_vertices() <= B.num_vertices()) {
     slots = slots_for(A, nb);
-    in_chunks(chunk_loop(nb, kFacetGrain, corner_facets, corner), chunk_loop(0, 1, nothing, none));
+    in_chunks(chunk_loop(nb, kFacetGrain, corner_facets, corner));
     const WalkStarts hints(A, B, loc_b);
     starts = &hints;
     slots = slots_for(B, na);
-    in_chunks(chunk_loop(na, kFacetGrain, translated_facets, translated),
-              chunk_loop(0, 1, nothing, none));
+    in_chunks(chunk_loop(na, kHintedGrain, translated_facets, translated));
+    auto head = [&] { gather_head(out, {&translated, &corner}, edge_estimate); };
     in_chunks(chunk_loop(A.num_edges(), kEdgeGrain, edge_facets_of, edge),
-              chunk_loop(0, 1, nothing, none));
+              chunk_loop(0, 1, edge_facets_of, none), &head);
+    append(out, {&edge});
   } else {
     slots = slots_for(B, na);
-    in_chunks(chunk_loop(na, kFacetGrain, translated_facets, translated),
-              chunk_loop(0, 1, nothing, none));
+    in_chunks(chunk_loop(na, kFacetGrain, translated_facets, translated));
     const WalkStarts hints(B, A, loc_a);
     starts = &hints;
     slots = slots_for(A, nb);
-    in_chunks(chunk_loop(nb, kFacetGrain, corner_facets, corner),
-              chunk_loop(A.num_edges(), kEdgeGrain, edge_facets_of, edge));
+    auto head = [&] { gather_head(out, {&translated}, nb + edge_estimate); };
+    in_chunks(chunk_loop(nb, kHintedGrain, corner_facets, corner),
+              chunk_loop(A.num_edges(), kEdgeGrain, edge_facets_of, edge), &head);
+    append(out, {&corner, &edge});
   }
-  return gather({&translated, &corner, &edge});
+  return out;
 }
 
 namespace {
