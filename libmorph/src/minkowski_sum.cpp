@@ -366,11 +366,11 @@ class WalkStarts {
   std::vector<int> first_, by_region_;
 };
 
-/// The planes of P's region slots when a loop of `walks` walks tests enough of them to pay
-/// for making them all first (see locate_all), else empty (each formed as it is tested).
-std::vector<ArcPlane> slots_for(const Polytope& P, int walks) {
-  if (4 * static_cast<std::size_t>(walks) >= P.fan_face.size()) return slot_planes(P);
-  return {};
+/// Whether `walks` walks on P's map test enough slots to pay for making each slot's plane
+/// once (a SlotCache), rather than forming it at each test: making one costs about as much
+/// as testing it, and a walk tests about ten; at least a quarter as many walks as slots.
+bool cache_slots(const Polytope& P, int walks) {
+  return 4 * static_cast<std::size_t>(walks) >= P.fan_face.size();
 }
 
 using BufferLists = std::initializer_list<const std::vector<FacetBuffer>*>;
@@ -422,26 +422,33 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
   const int na = A.num_faces(), nb = B.num_faces();
   std::vector<Location> loc_a(na), loc_b(nb);
   std::vector<FacetBuffer> translated, corner, edge, none;
-  std::vector<ArcPlane> slots;
+  // Per thread, the slot planes of the map walked on, when they pay (cache_slots).
+  tbb::enumerable_thread_specific<SlotCache> slots_a([&] { return SlotCache(A); });
+  tbb::enumerable_thread_specific<SlotCache> slots_b([&] { return SlotCache(B); });
+  const bool cache_a = cache_slots(A, nb), cache_b = cache_slots(B, na);
   const WalkStarts* starts = nullptr;  // null: each walk starts at the previous answer
   // Translated facets: one per facet of A.
   auto translated_facets = [&](int begin, int end, FacetBuffer& out, int& hint) {
-    const ArcPlane* const in_slots = slots.empty() ? nullptr : slots.data();
+    SlotCache* const slots = cache_b ? &slots_b.local() : nullptr;
     for (int f = begin; f < end; ++f) {
       const int start = starts ? (*starts)(f) : -1;
       if (start >= 0) hint = start;
-      loc_a[f] = locate(B, in_slots, NormalRef{&A, f}, hint, start < 0);
+      const NormalRef n{&A, f};
+      loc_a[f] =
+          slots ? locate(B, *slots, n, hint, start < 0) : locate(B, nullptr, n, hint, start < 0);
       hint = location_vertex(B, loc_a[f]);
       facet_at_normal(A, f, B, loc_a[f], true, out);
     }
   };
   // Corner facets: one per facet of B whose normal is not also a facet normal of A.
   auto corner_facets = [&](int begin, int end, FacetBuffer& out, int& hint) {
-    const ArcPlane* const in_slots = slots.empty() ? nullptr : slots.data();
+    SlotCache* const slots = cache_a ? &slots_a.local() : nullptr;
     for (int g = begin; g < end; ++g) {
       const int start = starts ? (*starts)(g) : -1;
       if (start >= 0) hint = start;
-      loc_b[g] = locate(A, in_slots, NormalRef{&B, g}, hint, start < 0);
+      const NormalRef n{&B, g};
+      loc_b[g] =
+          slots ? locate(A, *slots, n, hint, start < 0) : locate(A, nullptr, n, hint, start < 0);
       hint = location_vertex(A, loc_b[g]);
       if (loc_b[g].kind != Location::Kind::face) facet_at_normal(B, g, A, loc_b[g], false, out);
     }
@@ -470,22 +477,18 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
   // Edge facets: usually about as many as the edges of both (one per crossing of arcs).
   const std::size_t edge_estimate = A.num_edges() + B.num_edges();
   if (A.num_vertices() <= B.num_vertices()) {
-    slots = slots_for(A, nb);
     in_chunks(chunk_loop(nb, kFacetGrain, corner_facets, corner));
     const WalkStarts hints(A, B, loc_b);
     starts = &hints;
-    slots = slots_for(B, na);
     in_chunks(chunk_loop(na, kHintedGrain, translated_facets, translated));
     auto head = [&] { gather_head(out, {&translated, &corner}, edge_estimate); };
     in_chunks(chunk_loop(A.num_edges(), kEdgeGrain, edge_facets_of, edge),
               chunk_loop(0, 1, edge_facets_of, none), &head);
     append(out, {&edge});
   } else {
-    slots = slots_for(B, na);
     in_chunks(chunk_loop(na, kFacetGrain, translated_facets, translated));
     const WalkStarts hints(B, A, loc_a);
     starts = &hints;
-    slots = slots_for(A, nb);
     auto head = [&] { gather_head(out, {&translated}, nb + edge_estimate); };
     in_chunks(chunk_loop(nb, kHintedGrain, corner_facets, corner),
               chunk_loop(A.num_edges(), kEdgeGrain, edge_facets_of, edge), &head);
