@@ -440,8 +440,9 @@ TEST_CASE("fims: output is identical for any thread count") {
   const Mesh small = transformed(make_icosphere(0.4, 2), random_rotation(31));  // 320 triangles
   REQUIRE(big.n_faces() == 1280);
   REQUIRE(small.n_faces() == 320);
-  // Both orders: with one thread the operand with fewer vertices is located first, with
-  // more both are located side by side.
+  // Both orders: the facets of B are located first (then A's, then the edge facets; with
+  // threads, both side by side), or those of A (then B's and the edge facets in one loop);
+  // at two threads and more in chunks shared between the threads.
   for (const bool big_first : {true, false}) {
     CAPTURE(big_first);
     const Mesh& A = big_first ? big : small;

@@ -239,6 +239,51 @@ TEST_CASE("normal predicates: a region's slot planes agree with exact evaluation
   }
 }
 
+// The kernel's walks make a region's slot planes on first use (SlotCache): the same doubles
+// as slot_planes, so every walk answers as with them, or with planes formed at each test.
+// Walks from a far, fixed start and from the previous answer, on the pairs above.
+TEST_CASE("normal predicates: locate with a SlotCache answers as with slot_planes") {
+  using morph::detail::Location;
+  const Mesh ico1280 = sample("icosphere_1280.off");
+  const std::vector<std::pair<Mesh, Mesh>> pairs = {
+      {sample("icosphere_320.off"), ico1280},
+      {ico1280, morph::test::transformed(ico1280, small_rotation(1e-12))},
+      {morph::test::transformed(ico1280, {0x1p-200, 0, 0, 0, 0x1p-200, 0, 0, 0, 0x1p-200}),
+       morph::test::transformed(sample("icosphere_320.off"),
+                                {0x1p200, 0, 0, 0, 0x1p200, 0, 0, 0, 0x1p200})},
+      {shifted(sample("icosphere_320.off"), 1024), shifted(ico1280, -4096)}};
+  auto same = [](const Location& x, const Location& y) {
+    return x.kind == y.kind && x.index == y.index;
+  };
+  for (const auto& [a, b] : pairs) {
+    const Polytope A = morph::detail::make_operand(a, "A");
+    const Polytope B = morph::detail::make_operand(b, "B");
+    const auto slots = morph::detail::slot_planes(B);
+    morph::detail::SlotCache cache(B);
+    int differing = 0, hint = 0;
+    for (int f = 0; f < A.num_faces(); ++f) {
+      const NormalRef n{&A, f};
+      for (const int start : {0, B.num_vertices() - 1, hint}) {
+        const Location want = morph::detail::locate(B, slots.data(), n, start);
+        differing += !same(morph::detail::locate(B, cache, n, start), want);
+        differing += !same(morph::detail::locate(B, nullptr, n, start), want);
+      }
+      hint = morph::detail::location_vertex(B, morph::detail::locate(B, cache, n, hint));
+    }
+    CHECK(differing == 0);
+    // The cache's planes (made by the walks, or here for regions they did not reach) are
+    // slot_planes', bit for bit.
+    int planes_differing = 0;
+    for (int v = 0; v < B.num_vertices(); ++v) {
+      const morph::detail::ArcPlane* const made = cache.region(v);
+      for (int s = B.fan_begin[v]; s < B.fan_begin[v + 1]; ++s)
+        planes_differing += !(made[s].x == slots[s].x && made[s].y == slots[s].y &&
+                              made[s].z == slots[s].z && made[s].error == slots[s].error);
+    }
+    CHECK(planes_differing == 0);
+  }
+}
+
 // same_normal (gauss_map.h) spares the later stages the predicates on exactly coincident
 // normals (A (+) A, A (+) -A, A (+) an exact translate or a copy scaled by a power of two):
 // it must claim equal directions only where they are exactly equal (not for a copy scaled by

@@ -256,7 +256,11 @@ std::vector<ArcPlane> slot_planes(const Polytope& P) {
   return slots;
 }
 
-Location locate(const Polytope& P, const ArcPlane* slots, const NormalRef& p, int hint, bool step) {
+namespace {
+
+/// locate, with slots_of(v) giving the slot planes for v's region (or null).
+template <class SlotsOf>
+Location walk(const Polytope& P, const SlotsOf& slots_of, const NormalRef& p, int hint, bool step) {
   // First one cheap step in doubles: to the neighbour of the hint with the largest support
   // value <p, x>, if it beats the hint's. It only picks where the exact walk starts, which
   // then usually finds the region at once (climbing on to the top in doubles costs a scan
@@ -280,7 +284,7 @@ Location locate(const Polytope& P, const ArcPlane* slots, const NormalRef& p, in
   int nzeros = 0;
   const int limit = P.num_vertices() + 16;
   for (int steps = 0; steps < limit; ++steps) {
-    const int cross = region_test(P, slots, v, p, zeros, nzeros);
+    const int cross = region_test(P, slots_of(v), v, p, zeros, nzeros);
     if (cross < 0) return classify(P, v, zeros, nzeros);
     v = P.fan_vertex[P.fan_begin[v] + cross];
   }
@@ -288,8 +292,34 @@ Location locate(const Polytope& P, const ArcPlane* slots, const NormalRef& p, in
   // exactly planar; on facets planar only within the tolerance it might, so fall back
   // to testing every region.
   for (v = 0; v < P.num_vertices(); ++v)
-    if (region_test(P, slots, v, p, zeros, nzeros) < 0) return classify(P, v, zeros, nzeros);
+    if (region_test(P, slots_of(v), v, p, zeros, nzeros) < 0) return classify(P, v, zeros, nzeros);
   throw error("internal error: a direction lies in no region of the Gauss map");
+}
+
+}  // namespace
+
+Location locate(const Polytope& P, const ArcPlane* slots, const NormalRef& p, int hint, bool step) {
+  return walk(
+      P, [slots](int) { return slots; }, p, hint, step);
+}
+
+Location locate(const Polytope& P, SlotCache& slots, const NormalRef& p, int hint, bool step) {
+  return walk(
+      P, [&slots](int v) { return slots.region(v); }, p, hint, step);
+}
+
+SlotCache::SlotCache(const Polytope& P)
+    : P_(&P),
+      planes_(std::make_unique_for_overwrite<ArcPlane[]>(P.fan_face.size())),
+      made_(P.num_vertices(), 0) {}
+
+void SlotCache::make(int v) {
+  const int b = P_->fan_begin[v], n = P_->fan_begin[v + 1] - b;
+  const int* const fan = P_->fan_face.data() + b;
+  for (int i = 0; i < n; ++i)
+    planes_[b + i] =
+        cross_plane(P_->unit_normals[fan[i]], P_->unit_normals[fan[i + 1 == n ? 0 : i + 1]]);
+  made_[v] = 1;
 }
 
 std::vector<Location> locate_all(const Polytope& from, const Polytope& in,

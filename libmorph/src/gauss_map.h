@@ -4,6 +4,8 @@
 #pragma once
 
 #include <cmath>
+#include <memory>
+#include <vector>
 
 #include "polytope.h"
 
@@ -119,6 +121,29 @@ inline int orient_arc(const Polytope& P, int e, const ArcPlane& plane, const Nor
 /// for a hint already chosen by support), then walks exactly from region to region; the answer
 /// is exact and does not depend on the hint. Expected O(distance walked).
 Location locate(const Polytope& P, const ArcPlane* slots, const NormalRef& p, int hint,
+                bool step = true);
+
+/// P's slot planes (slot_planes), each region's made when a walk first tests it: for one
+/// thread's walks, which then share the making of them with the other threads' instead of
+/// waiting for all to be made first.
+class SlotCache {
+ public:
+  explicit SlotCache(const Polytope& P);
+  /// The planes, indexed by slot, those of v's region made.
+  const ArcPlane* region(int v) {
+    if (!made_[v]) make(v);
+    return planes_.get();
+  }
+
+ private:
+  void make(int v);
+  const Polytope* P_;
+  std::unique_ptr<ArcPlane[]> planes_;
+  std::vector<unsigned char> made_;
+};
+
+/// locate, with the slots' planes from a SlotCache.
+Location locate(const Polytope& P, SlotCache& slots, const NormalRef& p, int hint,
                 bool step = true);
 
 /// A vertex of the feature `loc` (the contributing vertex when it is a vertex region).

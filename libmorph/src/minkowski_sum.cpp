@@ -4,6 +4,7 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <initializer_list>
 #include <memory>
@@ -19,11 +20,14 @@ namespace morph::detail {
 
 namespace {
 
-// Elements per chunk of the facet loops. The output does not depend on it (buffers are
-// gathered in order). 128 balances two threads better on small operands, but its extra
-// buffers changed the heap's shape enough for glibc to trim and re-fault pages in the
-// assembly that follows (+0.07 ms on icosphere_320 (+) icosphere_1280): kept at 256.
-constexpr int kGrain = 256;
+// Elements per chunk of the facet loops. The output does not depend on them (buffers are
+// gathered in order, and every location is exact whatever the walk's start). Small enough
+// that two threads share a loop evenly (a chunk is a few microseconds of work); for walks
+// from the previous answer, large enough that a task's first walk, from vertex 0, costs
+// little (128: icosphere_320 (+) icosphere_1280 at two threads 95 us rather than 92).
+constexpr int kFacetGrain = 256;
+constexpr int kHintedGrain = 64;  // walks from WalkStarts: no restart at a chunk
+constexpr int kEdgeGrain = 64;
 
 Element element_of(const Polytope& P, const Location& loc) {
   switch (loc.kind) {
@@ -53,22 +57,57 @@ struct FacetBuffer {
   }
 };
 
-/// Runs body(begin, end, buffer) over [0, n) in fixed chunks (in parallel) and returns
-/// the chunks' buffers in order, so the result does not depend on the thread count.
+/// A loop of in_chunks: body(begin, end, buffer, hint) over [0, n) in chunks of `grain`.
+/// `hint` is the vertex where the task's previous walk ended (0 at a task's first chunk):
+/// chunks run by one task continue the walk from chunk to chunk.
 template <class Body>
-std::vector<FacetBuffer> in_chunks(int n, const Body& body) {
-  const int chunks = (n + kGrain - 1) / kGrain;
-  std::vector<FacetBuffer> buffers(chunks);
-  parallel_chunks(chunks, 1, [&](int first, int last) {
+struct ChunkLoop {
+  int n, grain;
+  const Body& body;
+  std::vector<FacetBuffer>* out;
+  int chunks() const { return (n + grain - 1) / grain; }
+};
+/// With one thread, one chunk per loop: fewer buffers to fill and gather.
+template <class Body>
+ChunkLoop<Body> chunk_loop(int n, int grain, const Body& body, std::vector<FacetBuffer>& out) {
+  return {n, tbb::this_task_arena::max_concurrency() == 1 ? std::max(n, 1) : grain, body, &out};
+}
+
+/// Runs `task` (unless null) and the chunks of both loops as one parallel loop (one join
+/// for all), each chunk writing its own buffer: the buffers are in loop order, whatever
+/// the schedule.
+template <class Body1, class Body2, class Task>
+void in_chunks(const ChunkLoop<Body1>& one, const ChunkLoop<Body2>& two, const Task* task) {
+  const int t = task ? 1 : 0, c1 = one.chunks(), c2 = two.chunks();
+  one.out->resize(c1);
+  two.out->resize(c2);
+  auto run = [](const auto& loop, int c, int& hint) {
+    FacetBuffer& b = (*loop.out)[c];
+    // About one facet per element, of about four corners.
+    b.sizes.reserve(loop.grain);
+    b.origins.reserve(loop.grain);
+    b.corners.reserve(4 * loop.grain);
+    loop.body(c * loop.grain, std::min(loop.n, (c + 1) * loop.grain), b, hint);
+  };
+  parallel_chunks(t + c1 + c2, 1, [&](int first, int last) {
+    int hint = 0;
     for (int c = first; c < last; ++c) {
-      // About one facet per element, of about four corners.
-      buffers[c].sizes.reserve(kGrain);
-      buffers[c].origins.reserve(kGrain);
-      buffers[c].corners.reserve(4 * kGrain);
-      body(c * kGrain, std::min(n, (c + 1) * kGrain), buffers[c]);
+      if (c < t)
+        (*task)();
+      else if (c < t + c1)
+        run(one, c - t, hint);
+      else {
+        if (c == t + c1) hint = 0;  // the second loop walks on another map
+        run(two, c - t - c1, hint);
+      }
     }
   });
-  return buffers;
+}
+template <class Body>
+void in_chunks(const ChunkLoop<Body>& one) {
+  std::vector<FacetBuffer> none;
+  const auto* no_task = static_cast<void (*const*)()>(nullptr);
+  in_chunks(one, chunk_loop(0, 1, one.body, none), no_task);
 }
 
 /// The facet of A (+) B whose normal is the normal of facet f of X (X is A when
@@ -270,156 +309,220 @@ bool facets_adjacent(const Polytope& P, int f, int g) {
   return false;
 }
 
-/// Where to start locating each facet f of X in Y's Gauss map, from Y's facets located in
-/// X's (loc_y): N_f is the common corner of the regions of f's corners in X's map, so the
+/// Where to start locating facets of X in Y's Gauss map, from Y's facets located in X's
+/// (loc_y): N_f is the common corner of the regions of f's corners in X's map, so the
 /// facets of Y whose normals those regions contain are the ones near it; the walk starts
 /// at the corner furthest along N_f of the nearest of them in the first such region that has
 /// any (nearest and furthest in doubles: they only pick where the exact walk starts; one
-/// region's scan costs less than the steps the others would spare). -1 when those regions
-/// contain none.
-std::vector<int> walk_starts(const Polytope& X, const Polytope& Y,
-                             const std::vector<Location>& loc_y) {
-  // Y's facets by the vertex of X whose region contains their normal (a counting sort).
-  std::vector<int> first(X.num_vertices() + 1, 0);
-  for (const Location& l : loc_y)
-    if (l.kind == Location::Kind::vertex) ++first[l.index + 1];
-  std::partial_sum(first.begin(), first.end(), first.begin());
-  std::vector<int> next(first.begin(), first.end() - 1), by_region(first.back());
-  for (int g = 0; g < Y.num_faces(); ++g)
-    if (loc_y[g].kind == Location::Kind::vertex) by_region[next[loc_y[g].index]++] = g;
-  std::vector<int> starts(X.num_faces(), -1);
-  parallel_chunks(X.num_faces(), 4096, [&](int begin, int end) {
-    for (int f = begin; f < end; ++f) {
-      const UnitNormal& n = X.unit_normals[f];
-      double best = -2;  // below any dot product of unit vectors
-      int nearest = -1;
-      for (int k = 0; k < X.degree(f) && nearest < 0; ++k) {  // the first region with any
-        const int u = X.corner(f, k);
-        for (int i = first[u]; i < first[u + 1]; ++i) {
-          const UnitNormal& m = Y.unit_normals[by_region[i]];
-          const double d = n.x * m.x + n.y * m.y + n.z * m.z;
-          if (d > best) {
-            best = d;
-            nearest = by_region[i];
-          }
-        }
-      }
-      if (nearest < 0) continue;
-      // Of its corners, the one furthest along N_f (the walk then starts there, without
-      // locate's step: that usually is the contributing vertex).
-      double top = -std::numeric_limits<double>::infinity();
-      for (int k = 0; k < Y.degree(nearest); ++k) {
-        const V3<double>& q = Y.points[Y.corner(nearest, k)];
-        const double h = n.x * q.x + n.y * q.y + n.z * q.z;
-        if (h > top) {
-          top = h;
-          starts[f] = Y.corner(nearest, k);
+/// region's scan costs less than the steps the others would spare).
+class WalkStarts {
+ public:
+  /// Y's facets by the vertex of X whose region contains their normal (a counting sort).
+  WalkStarts(const Polytope& X, const Polytope& Y, const std::vector<Location>& loc_y)
+      : X_(X), Y_(Y), first_(X.num_vertices() + 1, 0) {
+    for (const Location& l : loc_y)
+      if (l.kind == Location::Kind::vertex) ++first_[l.index + 1];
+    std::partial_sum(first_.begin(), first_.end(), first_.begin());
+    std::vector<int> next(first_.begin(), first_.end() - 1);
+    by_region_.resize(first_.back());
+    for (int g = 0; g < Y.num_faces(); ++g)
+      if (loc_y[g].kind == Location::Kind::vertex) by_region_[next[loc_y[g].index]++] = g;
+  }
+
+  /// The start for facet f of X: a vertex of Y, or -1 when the regions of f's corners
+  /// contain no facet normal of Y.
+  int operator()(int f) const {
+    const UnitNormal& n = X_.unit_normals[f];
+    double best = -2;  // below any dot product of unit vectors
+    int nearest = -1;
+    for (int k = 0; k < X_.degree(f) && nearest < 0; ++k) {  // the first region with any
+      const int u = X_.corner(f, k);
+      for (int i = first_[u]; i < first_[u + 1]; ++i) {
+        const UnitNormal& m = Y_.unit_normals[by_region_[i]];
+        const double d = n.x * m.x + n.y * m.y + n.z * m.z;
+        if (d > best) {
+          best = d;
+          nearest = by_region_[i];
         }
       }
     }
-  });
-  return starts;
+    if (nearest < 0) return -1;
+    // Of its corners, the one furthest along N_f (the walk then starts there, without
+    // locate's step: that usually is the contributing vertex).
+    double top = -std::numeric_limits<double>::infinity();
+    int start = -1;
+    for (int k = 0; k < Y_.degree(nearest); ++k) {
+      const V3<double>& q = Y_.points[Y_.corner(nearest, k)];
+      const double h = n.x * q.x + n.y * q.y + n.z * q.z;
+      if (h > top) {
+        top = h;
+        start = Y_.corner(nearest, k);
+      }
+    }
+    return start;
+  }
+
+ private:
+  const Polytope& X_;
+  const Polytope& Y_;
+  std::vector<int> first_, by_region_;
+};
+
+/// Whether `walks` walks on P's map test enough slots to pay for making each slot's plane
+/// once (a SlotCache), rather than forming it at each test: making one costs about as much
+/// as testing it, and a walk tests about ten; at least a quarter as many walks as slots.
+bool cache_slots(const Polytope& P, int walks) {
+  return 4 * static_cast<std::size_t>(walks) >= P.fan_face.size();
 }
 
-/// The facets of the buffers, in order: sizes summed once, each array filled in one go.
-SumFacets gather(std::initializer_list<const std::vector<FacetBuffer>*> lists) {
+using BufferLists = std::initializer_list<const std::vector<FacetBuffer>*>;
+
+/// Appends the facets of the buffers to `out`, in order: sizes summed once, each array
+/// extended in one go.
+void append(SumFacets& out, BufferLists lists) {
   std::size_t faces = 0, corners = 0;
   for (const auto* list : lists)
     for (const auto& b : *list) faces += b.origins.size(), corners += b.corners.size();
-  SumFacets out;
-  out.face_begin.resize(faces + 1);
-  out.corners.reserve(corners);
-  out.origins.reserve(faces);
-  int* begin = out.face_begin.data();
+  const std::size_t done = out.origins.size();
+  out.face_begin.resize(done + faces + 1);
+  out.corners.reserve(out.corners.size() + corners);
+  out.origins.reserve(done + faces);
+  int* begin = out.face_begin.data() + done;
   for (const auto* list : lists)
     for (const auto& b : *list) {
       for (int size : b.sizes) begin[1] = begin[0] + size, ++begin;
       out.corners.insert(out.corners.end(), b.corners.begin(), b.corners.end());
       out.origins.insert(out.origins.end(), b.origins.begin(), b.origins.end());
     }
-  return out;
+}
+
+/// The first part of the facets, gathered while the last loop makes the rest: the arrays
+/// made with room for about `more_faces` more facets of four corners (they grow if that
+/// was too few), the buffers appended.
+void gather_head(SumFacets& out, BufferLists lists, std::size_t more_faces) {
+  std::size_t faces = 0, corners = 0;
+  for (const auto* list : lists)
+    for (const auto& b : *list) faces += b.origins.size(), corners += b.corners.size();
+  out.face_begin.reserve(faces + more_faces + 1);
+  out.corners.reserve(corners + 4 * more_faces);
+  out.origins.reserve(faces + more_faces);
+  append(out, lists);
 }
 
 }  // namespace
 
 SumFacets fims_facets(const Polytope& A, const Polytope& B) {
-  // A's arc planes serve the edge loop (B's are formed as its walks need them).
-  const std::vector<ArcPlane> planes_a = arc_planes(A);
-  // Two independent branches (side by side when threads allow, each loop in parallel
-  // chunks too): the corner facets, which need B's facets located on A's map (loc_b), and
-  // the translated and edge facets, which need A's located on B's (loc_a). With one thread
-  // the facets of one are located first, walking on the coarser map (fewer vertices:
-  // shorter walks from the previous facet's answer), and those of the other then start next
-  // to the nearest of them (walk_starts), in the branch that needs them. Fewer joins than
-  // one loop after another, and the buffers are gathered in the same order whatever the
-  // schedule.
-  std::vector<Location> loc_a, loc_b;
-  std::vector<FacetBuffer> translated, corner, edge;
-  auto corner_facets = [&] {
-    // Corner facets: one per facet of B whose normal is not also a facet normal of A.
-    corner = in_chunks(B.num_faces(), [&](int begin, int end, FacetBuffer& out) {
-      for (int g = begin; g < end; ++g)
-        if (loc_b[g].kind != Location::Kind::face) facet_at_normal(B, g, A, loc_b[g], false, out);
-    });
+  // The facets of one operand are located first, walking on the other's map from the
+  // previous facet's answer: those of the one whose walks are shorter (on the coarser map,
+  // fewer vertices). The other's then start next to the nearest of them (WalkStarts). Each
+  // step is one parallel loop over chunks of all the facets it can make: 1. the first
+  // operand's facets located, with their translated or corner facets; 2. the other's
+  // likewise, and A's edge facets when A's facets were located in step 1; 3. A's edge
+  // facets otherwise (with threads, that case runs otherwise: see below). The chunks'
+  // buffers are gathered in the same order whatever the schedule.
+  const int na = A.num_faces(), nb = B.num_faces();
+  std::vector<Location> loc_a(na), loc_b(nb);
+  std::vector<FacetBuffer> translated, corner, edge, none;
+  // Per thread, the slot planes of the map walked on, when they pay (cache_slots).
+  tbb::enumerable_thread_specific<SlotCache> slots_a([&] { return SlotCache(A); });
+  tbb::enumerable_thread_specific<SlotCache> slots_b([&] { return SlotCache(B); });
+  const bool cache_a = cache_slots(A, nb), cache_b = cache_slots(B, na);
+  const WalkStarts* starts = nullptr;  // null: each walk starts at the previous answer
+  // Translated facets: one per facet of A.
+  auto translated_facets = [&](int begin, int end, FacetBuffer& out, int& hint) {
+    SlotCache* const slots = cache_b ? &slots_b.local() : nullptr;
+    for (int f = begin; f < end; ++f) {
+      const int start = starts ? (*starts)(f) : -1;
+      if (start >= 0) hint = start;
+      const NormalRef n{&A, f};
+      loc_a[f] =
+          slots ? locate(B, *slots, n, hint, start < 0) : locate(B, nullptr, n, hint, start < 0);
+      hint = location_vertex(B, loc_a[f]);
+      facet_at_normal(A, f, B, loc_a[f], true, out);
+    }
   };
-  auto translated_and_edge_facets = [&] {
-    // Translated facets: one per facet of A.
-    translated = in_chunks(A.num_faces(), [&](int begin, int end, FacetBuffer& out) {
-      for (int f = begin; f < end; ++f) facet_at_normal(A, f, B, loc_a[f], true, out);
-    });
-    // Edge facets: for every edge of A whose two facets have different contributing
-    // vertices, the edges of B whose arcs its arc crosses.
-    tbb::enumerable_thread_specific<WalkScratch> scratch([&] { return WalkScratch(B); });
-    edge = in_chunks(A.num_edges(), [&](int begin, int end, FacetBuffer& out) {
-      WalkScratch& w = scratch.local();
-      for (int a = begin; a < end; ++a) {
-        const auto& l = loc_a[A.edges[a].left];
-        const auto& r = loc_a[A.edges[a].right];
-        if (l.kind == Location::Kind::vertex && r.kind == Location::Kind::vertex &&
-            l.index == r.index)
-          continue;
-        // a's arc is an arc of B's map (its facets' normals are those of two adjacent facets
-        // of B: parallel edges, as in A (+) A): the other arcs of B meet it only at its ends,
-        // so it crosses none.
-        if (l.kind == Location::Kind::face && r.kind == Location::Kind::face &&
-            facets_adjacent(B, l.index, r.index))
-          continue;
-        edge_facets(A, a, planes_a[a], B, l, r, w, out);
-      }
-    });
+  // Corner facets: one per facet of B whose normal is not also a facet normal of A.
+  auto corner_facets = [&](int begin, int end, FacetBuffer& out, int& hint) {
+    SlotCache* const slots = cache_a ? &slots_a.local() : nullptr;
+    for (int g = begin; g < end; ++g) {
+      const int start = starts ? (*starts)(g) : -1;
+      if (start >= 0) hint = start;
+      const NormalRef n{&B, g};
+      loc_b[g] =
+          slots ? locate(A, *slots, n, hint, start < 0) : locate(A, nullptr, n, hint, start < 0);
+      hint = location_vertex(A, loc_b[g]);
+      if (loc_b[g].kind != Location::Kind::face) facet_at_normal(B, g, A, loc_b[g], false, out);
+    }
   };
-  if (tbb::this_task_arena::max_concurrency() > 1) {
-    // With threads to spare, the two sides from the start, each locating its own facets
-    // (without walk_starts' hints, which would make one wait for the other): more walking in
-    // all, but no serial step before the branches (icosphere_320 (+) icosphere_1280 at two
-    // threads: 118 -> 110 us). The locations are exact, so the same either way.
+  // Edge facets: for every edge of A whose two facets have different contributing
+  // vertices, the edges of B whose arcs its arc crosses.
+  tbb::enumerable_thread_specific<WalkScratch> scratch([&] { return WalkScratch(B); });
+  auto edge_facets_of = [&](int begin, int end, FacetBuffer& out, int&) {
+    WalkScratch& w = scratch.local();
+    for (int a = begin; a < end; ++a) {
+      const auto& l = loc_a[A.edges[a].left];
+      const auto& r = loc_a[A.edges[a].right];
+      if (l.kind == Location::Kind::vertex && r.kind == Location::Kind::vertex &&
+          l.index == r.index)
+        continue;
+      // a's arc is an arc of B's map (its facets' normals are those of two adjacent facets
+      // of B: parallel edges, as in A (+) A): the other arcs of B meet it only at its ends,
+      // so it crosses none.
+      if (l.kind == Location::Kind::face && r.kind == Location::Kind::face &&
+          facets_adjacent(B, l.index, r.index))
+        continue;
+      edge_facets(A, a, arc_plane(A, a), B, l, r, w, out);
+    }
+  };
+  SumFacets out;
+  // Edge facets: usually about as many as the edges of both (one per crossing of arcs).
+  const std::size_t edge_estimate = A.num_edges() + B.num_edges();
+  if (tbb::this_task_arena::max_concurrency() > 1 && A.num_vertices() <= B.num_vertices()) {
+    // With threads, where the steps below would be three loops, the two operands' facets
+    // are located side by side from the start instead, each walk from the previous answer
+    // (more walking in all, but no locating before the other side can start), and the edge
+    // facets follow on A's side, in chunks that the other thread takes once its side is done.
+    // Measured at two threads: icosphere_320 (+) icosphere_1280 93 us rather than 104 in
+    // three loops, icosphere_5120 (+) a rotated copy 0.51 ms rather than 0.58 (each thread
+    // runs its chunks 25-60% slower than one thread alone would: the fewer steps, the
+    // better). With A's facets located first the steps are two loops, and faster so
+    // (uvsphere_1600 (+) snub_dodecahedron 77 us rather than 91). Whichever side finishes
+    // its facets second gathers both into the result (the same facets either way).
+    std::atomic<int> sides_done{0};
+    auto side_done = [&] {
+      if (sides_done.fetch_add(1, std::memory_order_acq_rel) == 1)
+        gather_head(out, {&translated, &corner}, edge_estimate);
+    };
     run_both(
         [&] {
-          loc_b = locate_all(B, A);
-          corner_facets();
+          in_chunks(chunk_loop(nb, kFacetGrain, corner_facets, corner));
+          side_done();
         },
         [&] {
-          loc_a = locate_all(A, B);
-          translated_and_edge_facets();
+          in_chunks(chunk_loop(na, kFacetGrain, translated_facets, translated));
+          side_done();
+          in_chunks(chunk_loop(A.num_edges(), kEdgeGrain, edge_facets_of, edge));
         });
+    append(out, {&edge});
   } else if (A.num_vertices() <= B.num_vertices()) {
-    loc_b = locate_all(B, A);
-    run_both(corner_facets, [&] {
-      const std::vector<int> hints_a = walk_starts(A, B, loc_b);
-      loc_a = locate_all(A, B, &hints_a);
-      translated_and_edge_facets();
-    });
+    in_chunks(chunk_loop(nb, kFacetGrain, corner_facets, corner));
+    const WalkStarts hints(A, B, loc_b);
+    starts = &hints;
+    in_chunks(chunk_loop(na, kHintedGrain, translated_facets, translated));
+    auto head = [&] { gather_head(out, {&translated, &corner}, edge_estimate); };
+    in_chunks(chunk_loop(A.num_edges(), kEdgeGrain, edge_facets_of, edge),
+              chunk_loop(0, 1, edge_facets_of, none), &head);
+    append(out, {&edge});
   } else {
-    loc_a = locate_all(A, B);
-    run_both(
-        [&] {
-          const std::vector<int> hints_b = walk_starts(B, A, loc_a);
-          loc_b = locate_all(B, A, &hints_b);
-          corner_facets();
-        },
-        translated_and_edge_facets);
+    in_chunks(chunk_loop(na, kFacetGrain, translated_facets, translated));
+    const WalkStarts hints(B, A, loc_a);
+    starts = &hints;
+    auto head = [&] { gather_head(out, {&translated}, nb + edge_estimate); };
+    in_chunks(chunk_loop(nb, kHintedGrain, corner_facets, corner),
+              chunk_loop(A.num_edges(), kEdgeGrain, edge_facets_of, edge), &head);
+    append(out, {&corner, &edge});
   }
-  return gather({&translated, &corner, &edge});
+  return out;
 }
 
 namespace {
