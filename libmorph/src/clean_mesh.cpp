@@ -29,6 +29,7 @@
 #include <memory>
 #include <numeric>
 #include <optional>
+#include <queue>
 
 #include "fims.h"
 #include "parallel.h"
@@ -269,50 +270,70 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
     return true;
   };
   const int nc = static_cast<int>(soup.vertex.size());
-  // While both facets of an edge are alone (each its own group, its own reference), the
-  // edge's test reads only the two facets, not the groups that the joins before it made:
-  // every edge is so tested beforehand, in parallel (`joins`, at its first corner), and
-  // the loop below tests again only edges of facets that joined a group (few). The
-  // groups are those of testing every edge in order.
-  const auto joins = std::make_unique_for_overwrite<char[]>(nc);
-  parallel_chunks(nc, kEdgeTestGrain, [&](int first, int last) {
+  // The groups are those of testing every edge (by its first corner) in order. While both
+  // facets of an edge are alone (each its own group and reference), its test reads only
+  // the two facets, not what the joins before it made: every edge is so tested beforehand,
+  // in parallel, in fixed blocks of corners; the loop below then takes, in order, the
+  // edges that passed (`passed`, few) and the later edges of each facet that joins a group
+  // (`later`), whose test depends on the joins. An edge in neither has both facets alone
+  // when its turn comes, and failed: it joins nothing.
+  const int num_blocks = (nc + kEdgeTestGrain - 1) / kEdgeTestGrain;
+  std::vector<std::vector<int>> passed(num_blocks);
+  parallel_chunks(num_blocks, 1, [&](int first_block, int last_block) {
     const int *twin = k.twin.data(), *face = k.face.data();
-    char* const join = joins.get();
-    for (int c = first; c < last; ++c) {
-      const int t = twin[c];
-      if (t < c) continue;
-      int a = face[c], b = face[t];
-      int edge_b = t;
-      if (geo[a].twice_area < geo[b].twice_area) {
-        std::swap(a, b);
-        edge_b = c;
+    for (int block = first_block; block < last_block; ++block)
+      for (int c = block * kEdgeTestGrain; c < std::min(nc, (block + 1) * kEdgeTestGrain); ++c) {
+        const int t = twin[c];
+        if (t < c) continue;
+        int a = face[c], b = face[t];
+        int edge_b = t;
+        if (geo[a].twice_area < geo[b].twice_area) {
+          std::swap(a, b);
+          edge_b = c;
+        }
+        if (a != b && holds(a, b, edge_b)) passed[block].push_back(c);
       }
-      join[c] = a != b && holds(a, b, edge_b);
-    }
   });
   std::vector<char> alone(nf, 1);
-  for (int c = 0; c < nc; ++c) {
+  std::priority_queue<int, std::vector<int>, std::greater<>> later;
+  // Each facet's edges after `c`, which it joined a group at.
+  const auto retest = [&](int f, int c) {
+    for (int e = soup.begin[f]; e < soup.begin[f + 1]; ++e)
+      if (std::min(e, k.twin[e]) > c) later.push(std::min(e, k.twin[e]));
+  };
+  const auto join = [&](int c) {
     const int t = k.twin[c];
-    if (t < c) continue;
     const bool tested = alone[k.face[c]] && alone[k.face[t]];
-    if (tested && !joins[c]) continue;
     int a = sets.find(k.face[c]), b = sets.find(k.face[t]);
-    if (a == b) continue;
+    if (a == b) return;
     int edge_b = t;  // b's corner on the edge
     if (geo[reference[a]].twice_area < geo[reference[b]].twice_area) {
       std::swap(a, b);
       edge_b = c;
     }
     // a has the larger reference facet.
-    if (!tested && !holds(reference[a], b, edge_b)) continue;
+    if (!tested && !holds(reference[a], b, edge_b)) return;
     const int root = std::min(a, b), other = std::max(a, b);
     sets.unite(a, b);  // names the joined set `root`
     reference[root] = reference[a];
     next_member[last_member[root]] = other;
     last_member[root] = last_member[other];
-    alone[a] = alone[b] = 0;
+    for (const int g : {a, b})
+      if (alone[g]) {
+        alone[g] = 0;
+        retest(g, c);
+      }
     out.merged = true;
-  }
+  };
+  int done = -1;  // the last edge taken
+  for (const std::vector<int>& block : passed)
+    for (const int c : block) {
+      for (; !later.empty() && later.top() <= c; later.pop())
+        if (later.top() > done) join(done = later.top());
+      if (c > done) join(done = c);
+    }
+  for (; !later.empty(); later.pop())
+    if (later.top() > done) join(done = later.top());
   out.of.resize(nf);
   for (int f = 0; f < nf; ++f) out.of[f] = sets.find(f);
   return out;
