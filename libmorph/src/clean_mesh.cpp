@@ -1067,18 +1067,19 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
     // Nothing merged (the usual case): the facets are the soup as they are, unless one has a
     // repeated corner or fewer than three. Only a facet compared by its sides alone can still
     // have one (the others would have been marked above).
-    as_given = !any_close;
+    bool given = !any_close;      // a local: `as_given` is the caller's
     std::vector<int> last_facet;  // the last facet a point was seen in, to find repeats
-    for (int f = 0; f < nf && as_given; ++f) {
+    for (int f = 0; f < nf && given; ++f) {
       const int b = face_begin[f], e = face_begin[f + 1];
-      as_given = e - b >= 3;
+      given = e - b >= 3;
       if (e - b <= kPairwiseDegree) continue;
       if (last_facet.empty()) last_facet.assign(n, -1);
-      for (int c = b; c < e && as_given; ++c) {
-        as_given = last_facet[corners[c]] != f;
+      for (int c = b; c < e && given; ++c) {
+        given = last_facet[corners[c]] != f;
         last_facet[corners[c]] = f;
       }
     }
+    as_given = given;
     if (ahead && as_given) {
       pre.geo = std::make_unique_for_overwrite<FacetGeometry[]>(nf);
       geometries(points, soup, pre.geo.get());
