@@ -29,6 +29,7 @@
 #include <memory>
 #include <numeric>
 #include <optional>
+#include <queue>
 
 #include "fims.h"
 #include "parallel.h"
@@ -84,6 +85,10 @@ struct Connectivity {
 constexpr int kFacetGrain = 512;
 constexpr int kCornerGrain = 8192;
 constexpr int kVertexGrain = 4096;
+// Loops that do more per element (a plane test per edge, a walk around each vertex) pay
+// for their task in smaller chunks.
+constexpr int kEdgeTestGrain = 2048;
+constexpr int kFanGrain = 512;
 
 /// The facet, next and previous corner of every corner (no twins yet).
 Connectivity facet_cycles(const Soup& soup) {
@@ -265,25 +270,70 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
     return true;
   };
   const int nc = static_cast<int>(soup.vertex.size());
-  for (int c = 0; c < nc; ++c) {
+  // The groups are those of testing every edge (by its first corner) in order. While both
+  // facets of an edge are alone (each its own group and reference), its test reads only
+  // the two facets, not what the joins before it made: every edge is so tested beforehand,
+  // in parallel, in fixed blocks of corners; the loop below then takes, in order, the
+  // edges that passed (`passed`, few) and the later edges of each facet that joins a group
+  // (`later`), whose test depends on the joins. An edge in neither has both facets alone
+  // when its turn comes, and failed: it joins nothing.
+  const int num_blocks = (nc + kEdgeTestGrain - 1) / kEdgeTestGrain;
+  std::vector<std::vector<int>> passed(num_blocks);
+  parallel_chunks(num_blocks, 1, [&](int first_block, int last_block) {
+    const int *twin = k.twin.data(), *face = k.face.data();
+    for (int block = first_block; block < last_block; ++block)
+      for (int c = block * kEdgeTestGrain; c < std::min(nc, (block + 1) * kEdgeTestGrain); ++c) {
+        const int t = twin[c];
+        if (t < c) continue;
+        int a = face[c], b = face[t];
+        int edge_b = t;
+        if (geo[a].twice_area < geo[b].twice_area) {
+          std::swap(a, b);
+          edge_b = c;
+        }
+        if (a != b && holds(a, b, edge_b)) passed[block].push_back(c);
+      }
+  });
+  std::vector<char> alone(nf, 1);
+  std::priority_queue<int, std::vector<int>, std::greater<>> later;
+  // Each facet's edges after `c`, which it joined a group at.
+  const auto retest = [&](int f, int c) {
+    for (int e = soup.begin[f]; e < soup.begin[f + 1]; ++e)
+      if (std::min(e, k.twin[e]) > c) later.push(std::min(e, k.twin[e]));
+  };
+  const auto join = [&](int c) {
     const int t = k.twin[c];
-    if (t < c) continue;
+    const bool tested = alone[k.face[c]] && alone[k.face[t]];
     int a = sets.find(k.face[c]), b = sets.find(k.face[t]);
-    if (a == b) continue;
+    if (a == b) return;
     int edge_b = t;  // b's corner on the edge
     if (geo[reference[a]].twice_area < geo[reference[b]].twice_area) {
       std::swap(a, b);
       edge_b = c;
     }
     // a has the larger reference facet.
-    if (!holds(reference[a], b, edge_b)) continue;
+    if (!tested && !holds(reference[a], b, edge_b)) return;
     const int root = std::min(a, b), other = std::max(a, b);
     sets.unite(a, b);  // names the joined set `root`
     reference[root] = reference[a];
     next_member[last_member[root]] = other;
     last_member[root] = last_member[other];
+    for (const int g : {a, b})
+      if (alone[g]) {
+        alone[g] = 0;
+        retest(g, c);
+      }
     out.merged = true;
-  }
+  };
+  int done = -1;  // the last edge taken
+  for (const std::vector<int>& block : passed)
+    for (const int c : block) {
+      for (; !later.empty() && later.top() <= c; later.pop())
+        if (later.top() > done) join(done = later.top());
+      if (c > done) join(done = c);
+    }
+  for (; !later.empty(); later.pop())
+    if (later.top() > done) join(done = later.top());
   out.of.resize(nf);
   for (int f = 0; f < nf; ++f) out.of[f] = sets.find(f);
   return out;
@@ -358,7 +408,7 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
   const int np = static_cast<int>(points.size());
   std::vector<char> keep(np, 0);
   std::atomic<bool> dropped{false};
-  parallel_chunks(np, kVertexGrain, [&](int first, int last) {
+  parallel_chunks(np, kFanGrain, [&](int first, int last) {
     bool here = false;
     for (int v = first; v < last; ++v) {
       const int c = k.first_out[v];
@@ -559,34 +609,49 @@ std::optional<Connectivity> connect_with(int num_points, const Soup& soup, Merge
   return k;
 }
 
+/// Each facet's geometry, in `geo` (of soup.size() elements).
+void geometries(const std::vector<V3<double>>& points, const Soup& soup, FacetGeometry* geo) {
+  parallel_chunks(soup.size(), kFacetGrain, [&](int first, int last) {
+    for (int f = first; f < last; ++f) geo[f] = geometry(points, soup, f);
+  });
+}
+
+/// What pass 2 starts from: the soup's connectivity (nothing when it is not a closed
+/// manifold) and its facets' geometry, when they were found beforehand (`geo` set).
+struct Prepared {
+  std::optional<Connectivity> k;
+  std::unique_ptr<FacetGeometry[]> geo;
+};
+
 /// Passes 2 and 3, then connectivity of the result. Strict: nothing when the soup is not
 /// a closed manifold or merging fails; else (hull facets) an unmerged soup is kept.
 /// `soup` is moved into the result when it is the result, and left alone otherwise.
+/// `pre`: the soup's connectivity and geometry, if already found.
 std::optional<std::pair<Soup, Connectivity>> simplify(const std::vector<V3<double>>& points,
-                                                      Soup& soup, double limit, bool strict) {
-  // The facets' geometry (for pass 2) does not depend on the connectivity: with threads to
-  // spare, computed beside `connect` (the two loops side by side, rather than each split
-  // into chunks too short to pay at a few thousand facets); else after it, if it succeeds.
-  const int nf = soup.size();
-  const auto geo = std::make_unique_for_overwrite<FacetGeometry[]>(nf);
-  const auto geometries = [&] {
-    parallel_chunks(nf, kFacetGrain, [&](int first, int last) {
-      for (int f = first; f < last; ++f) geo[f] = geometry(points, soup, f);
-    });
-  };
-  std::optional<Connectivity> k;
-  if (nf >= kFacetGrain && tbb::this_task_arena::max_concurrency() > 1) {
-    run_both(geometries, [&] { k = connect(static_cast<int>(points.size()), soup); });
-    if (!k) return std::nullopt;
-  } else {
-    k = connect(static_cast<int>(points.size()), soup);
-    if (!k) return std::nullopt;
-    geometries();
+                                                      Soup& soup, double limit, bool strict,
+                                                      Prepared pre = {}) {
+  std::optional<Connectivity>& k = pre.k;
+  if (!pre.geo) {
+    // The facets' geometry (for pass 2) does not depend on the connectivity: with threads
+    // to spare, computed beside `connect` (the two loops side by side, rather than each
+    // split into chunks too short to pay at a few thousand facets); else after it, if it
+    // succeeds.
+    const int nf = soup.size();
+    pre.geo = std::make_unique_for_overwrite<FacetGeometry[]>(nf);
+    if (nf >= kFacetGrain && tbb::this_task_arena::max_concurrency() > 1) {
+      run_both([&] { geometries(points, soup, pre.geo.get()); },
+               [&] { k = connect(static_cast<int>(points.size()), soup); });
+    } else {
+      k = connect(static_cast<int>(points.size()), soup);
+      if (k) geometries(points, soup, pre.geo.get());
+    }
   }
+  if (!k) return std::nullopt;
+  const FacetGeometry* const geo = pre.geo.get();
   Soup merged;
   MergedTwins merged_twins;
   bool changed = false;
-  if (!merge_coplanar(points, soup, *k, geo.get(), limit, strict, merged, merged_twins, changed)) {
+  if (!merge_coplanar(points, soup, *k, geo, limit, strict, merged, merged_twins, changed)) {
     if (strict) return std::nullopt;
     return std::make_pair(std::move(soup), std::move(*k));
   }
@@ -893,122 +958,147 @@ std::atomic<long> hull_fallbacks{0};
 long clean_mesh_hull_fallbacks() { return hull_fallbacks.load(std::memory_order_relaxed); }
 
 Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& face_begin,
-                std::vector<int> corners, std::vector<int>* source) {
+                std::vector<int> facet_corners, std::vector<int>* source) {
   constexpr int kPairwiseDegree = 16;  // facets up to this degree are checked corner by corner
   const int n = static_cast<int>(points.size());
   const int nf = static_cast<int>(face_begin.size()) - 1;
-  V3<double> lo{0, 0, 0}, hi{0, 0, 0};
-  if (n > 0) lo = hi = points[0];
-  for (const auto& p : points) {
-    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
-  }
-  const V3<double> span = hi - lo;
-  const double limit = kFeatureTolerance * std::sqrt(dot(span, span));
-  // Points whose rounding unit exceeds the feature size (a result far from the origin for
-  // its size) carry noise that merging cannot remove; the hull drops what of it is not
-  // extreme, and gives a simpler mesh there. So a facet folded onto itself is split only
-  // when the points are finer than the feature size, and otherwise left to the hull.
-  const double magnitude = std::max({std::abs(lo.x), std::abs(lo.y), std::abs(lo.z), std::abs(hi.x),
-                                     std::abs(hi.y), std::abs(hi.z)});
-  const bool fine = magnitude * std::numeric_limits<double>::epsilon() <= limit;
-  // Pass 1: clusters of close corners, each represented by its lowest vertex.
-  UnionFind clusters(n);
-  // Squared distances above `far` are beyond `limit` whatever the rounding of its square
-  // (a margin of 2), so most pairs need no square root.
-  const double limit_squared = limit * limit;
-  const double far = limit_squared >= std::numeric_limits<double>::min()
-                         ? 2 * limit_squared
-                         : std::numeric_limits<double>::infinity();
-  auto close = [&](int u, int w) {
-    const V3<double> d = points[u] - points[w];
-    const double distance_squared = dot(d, d);
-    return distance_squared <= far && std::sqrt(distance_squared) <= limit;
-  };
-  // Calls pair(u, w) on the corners of facet f that are compared.
-  auto for_pairs = [&](int f, const auto& pair) {
-    const int b = face_begin[f], e = face_begin[f + 1];
-    if (e - b <= kPairwiseDegree) {  // also across a facet: the diagonal of a thin parallelogram
-      for (int c = b; c < e; ++c)
-        for (int d = c + 1; d < e; ++d) pair(corners[c], corners[d]);
-    } else {
-      for (int c = b; c < e; ++c) pair(corners[c], corners[c + 1 == e ? b : c + 1]);
-    }
-  };
-  // Triangles and quadrilaterals (nearly all facets): no pair is close when none is within
-  // `far` nor repeated, decided from their points loaded once and without a branch per pair
-  // (`close` of a pair is false unless its squared distance is at most `far`).
-  const auto squared = [&](const V3<double>& p, const V3<double>& q) {
-    const V3<double> d = p - q;
-    return dot(d, d);
-  };
-  auto surely_apart = [&](int f) {
-    const int b = face_begin[f], e = face_begin[f + 1];
-    const int* v = corners.data() + b;
-    if (e - b == 3) {
-      const V3<double>&p0 = points[v[0]], &p1 = points[v[1]], &p2 = points[v[2]];
-      return !((squared(p0, p1) <= far) | (squared(p0, p2) <= far) | (squared(p1, p2) <= far) |
-               (v[0] == v[1]) | (v[0] == v[2]) | (v[1] == v[2]));
-    }
-    if (e - b == 4) {
-      const V3<double>&p0 = points[v[0]], &p1 = points[v[1]], &p2 = points[v[2]],
-            &p3 = points[v[3]];
-      return !((squared(p0, p1) <= far) | (squared(p0, p2) <= far) | (squared(p0, p3) <= far) |
-               (squared(p1, p2) <= far) | (squared(p1, p3) <= far) | (squared(p2, p3) <= far) |
-               (v[0] == v[1]) | (v[0] == v[2]) | (v[0] == v[3]) | (v[1] == v[2]) | (v[1] == v[3]) |
-               (v[2] == v[3]));
-    }
-    return false;
-  };
-  // The facets with close corners (few), found in parallel; their unions follow in order.
-  // A corner repeated in a facet compared pair by pair marks it too (it is close to itself
-  // unless its point is not finite): the facets are then not the soup as they are, and the
-  // unions below are those of close corners either way.
-  std::vector<char> has_close(nf, 0);
-  std::atomic<bool> any_close{false};
-  parallel_chunks(nf, kFacetGrain, [&](int first, int last) {
-    bool found = false;
-    for (int f = first; f < last; ++f) {
-      bool here = false;
-      if (!surely_apart(f))
-        for_pairs(f, [&](int u, int w) { here = here || u == w || close(u, w); });
-      has_close[f] = here;
-      found = found || here;
-    }
-    if (found) any_close.store(true, std::memory_order_relaxed);
-  });
-  if (any_close.load())
-    for (int f = 0; f < nf; ++f)
-      if (has_close[f])
-        for_pairs(f, [&](int u, int w) {
-          if (close(u, w)) clusters.unite(u, w);
-        });
+  // The facets as given: the soup when nothing merges (the usual case).
   Soup soup;
-  bool repeated = false;
-  std::vector<int> last_facet;  // the last facet a point was seen in, to find repeats
-  // Nothing merged (the usual case): the facets are the soup as they are, unless one has a
-  // repeated corner or fewer than three. Only a facet compared by its sides alone can still
-  // have one (the others would have been marked above).
-  bool as_given = !any_close.load();
-  for (int f = 0; f < nf && as_given; ++f) {
-    const int b = face_begin[f], e = face_begin[f + 1];
-    as_given = e - b >= 3;
-    if (e - b <= kPairwiseDegree) continue;
-    if (last_facet.empty()) last_facet.assign(n, -1);
-    for (int c = b; c < e && as_given; ++c) {
-      as_given = last_facet[corners[c]] != f;
-      last_facet[corners[c]] = f;
+  soup.begin = face_begin;
+  soup.vertex = std::move(facet_corners);
+  const std::vector<int>& corners = soup.vertex;
+  // With threads to spare, the soup's connectivity and its facets' geometry (pass 2's
+  // input) are found beside pass 1, on the chance that the facets are the soup as they
+  // are (rather than `simplify` splitting each into chunks too short to pay at a few
+  // thousand facets). They are dropped if not.
+  const bool ahead = nf >= kFacetGrain && tbb::this_task_arena::max_concurrency() > 1;
+  Prepared pre;
+  UnionFind clusters(n);
+  double limit = 0;
+  bool fine = false, any_close = false, as_given = false;
+  // Pass 1's search for close corners, and whether the facets are the soup as they are.
+  const auto find_close = [&] {
+    V3<double> lo{0, 0, 0}, hi{0, 0, 0};
+    if (n > 0) lo = hi = points[0];
+    for (const auto& p : points) {
+      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
     }
-  }
+    const V3<double> span = hi - lo;
+    limit = kFeatureTolerance * std::sqrt(dot(span, span));
+    // Points whose rounding unit exceeds the feature size (a result far from the origin for
+    // its size) carry noise that merging cannot remove; the hull drops what of it is not
+    // extreme, and gives a simpler mesh there. So a facet folded onto itself is split only
+    // when the points are finer than the feature size, and otherwise left to the hull.
+    const double magnitude = std::max({std::abs(lo.x), std::abs(lo.y), std::abs(lo.z),
+                                       std::abs(hi.x), std::abs(hi.y), std::abs(hi.z)});
+    fine = magnitude * std::numeric_limits<double>::epsilon() <= limit;
+    // Pass 1: clusters of close corners, each represented by its lowest vertex.
+    // Squared distances above `far` are beyond `limit` whatever the rounding of its square
+    // (a margin of 2), so most pairs need no square root.
+    const double limit_squared = limit * limit;
+    const double far = limit_squared >= std::numeric_limits<double>::min()
+                           ? 2 * limit_squared
+                           : std::numeric_limits<double>::infinity();
+    auto close = [&](int u, int w) {
+      const V3<double> d = points[u] - points[w];
+      const double distance_squared = dot(d, d);
+      return distance_squared <= far && std::sqrt(distance_squared) <= limit;
+    };
+    // Calls pair(u, w) on the corners of facet f that are compared.
+    auto for_pairs = [&](int f, const auto& pair) {
+      const int b = face_begin[f], e = face_begin[f + 1];
+      if (e - b <= kPairwiseDegree) {  // also across a facet: the diagonal of a thin parallelogram
+        for (int c = b; c < e; ++c)
+          for (int d = c + 1; d < e; ++d) pair(corners[c], corners[d]);
+      } else {
+        for (int c = b; c < e; ++c) pair(corners[c], corners[c + 1 == e ? b : c + 1]);
+      }
+    };
+    // Triangles and quadrilaterals (nearly all facets): no pair is close when none is within
+    // `far` nor repeated, decided from their points loaded once and without a branch per pair
+    // (`close` of a pair is false unless its squared distance is at most `far`).
+    const auto squared = [&](const V3<double>& p, const V3<double>& q) {
+      const V3<double> d = p - q;
+      return dot(d, d);
+    };
+    auto surely_apart = [&](int f) {
+      const int b = face_begin[f], e = face_begin[f + 1];
+      const int* v = corners.data() + b;
+      if (e - b == 3) {
+        const V3<double>&p0 = points[v[0]], &p1 = points[v[1]], &p2 = points[v[2]];
+        return !((squared(p0, p1) <= far) | (squared(p0, p2) <= far) | (squared(p1, p2) <= far) |
+                 (v[0] == v[1]) | (v[0] == v[2]) | (v[1] == v[2]));
+      }
+      if (e - b == 4) {
+        const V3<double>&p0 = points[v[0]], &p1 = points[v[1]], &p2 = points[v[2]],
+              &p3 = points[v[3]];
+        return !((squared(p0, p1) <= far) | (squared(p0, p2) <= far) | (squared(p0, p3) <= far) |
+                 (squared(p1, p2) <= far) | (squared(p1, p3) <= far) | (squared(p2, p3) <= far) |
+                 (v[0] == v[1]) | (v[0] == v[2]) | (v[0] == v[3]) | (v[1] == v[2]) |
+                 (v[1] == v[3]) | (v[2] == v[3]));
+      }
+      return false;
+    };
+    // The facets with close corners (few), found in parallel; their unions follow in order.
+    // A corner repeated in a facet compared pair by pair marks it too (it is close to itself
+    // unless its point is not finite): the facets are then not the soup as they are, and the
+    // unions below are those of close corners either way.
+    std::vector<char> has_close(nf, 0);
+    std::atomic<bool> some_close{false};
+    parallel_chunks(nf, kFacetGrain, [&](int first, int last) {
+      bool found = false;
+      for (int f = first; f < last; ++f) {
+        bool here = false;
+        if (!surely_apart(f))
+          for_pairs(f, [&](int u, int w) { here = here || u == w || close(u, w); });
+        has_close[f] = here;
+        found = found || here;
+      }
+      if (found) some_close.store(true, std::memory_order_relaxed);
+    });
+    any_close = some_close.load();
+    if (any_close)
+      for (int f = 0; f < nf; ++f)
+        if (has_close[f])
+          for_pairs(f, [&](int u, int w) {
+            if (close(u, w)) clusters.unite(u, w);
+          });
+    // Nothing merged (the usual case): the facets are the soup as they are, unless one has a
+    // repeated corner or fewer than three. Only a facet compared by its sides alone can still
+    // have one (the others would have been marked above).
+    bool given = !any_close;      // a local: `as_given` is the caller's
+    std::vector<int> last_facet;  // the last facet a point was seen in, to find repeats
+    for (int f = 0; f < nf && given; ++f) {
+      const int b = face_begin[f], e = face_begin[f + 1];
+      given = e - b >= 3;
+      if (e - b <= kPairwiseDegree) continue;
+      if (last_facet.empty()) last_facet.assign(n, -1);
+      for (int c = b; c < e && given; ++c) {
+        given = last_facet[corners[c]] != f;
+        last_facet[corners[c]] = f;
+      }
+    }
+    as_given = given;
+    if (ahead && as_given) {
+      pre.geo = std::make_unique_for_overwrite<FacetGeometry[]>(nf);
+      geometries(points, soup, pre.geo.get());
+    }
+  };
+  if (ahead)
+    run_both(find_close, [&] { pre.k = connect(n, soup); });
+  else
+    find_close();
+  bool repeated = false;
   if (as_given) {
-    soup.begin = face_begin;
-    soup.vertex = std::move(corners);
     soup.source.resize(nf);
     std::iota(soup.source.begin(), soup.source.end(), 0);
   } else {
-    last_facet.assign(n, -1);
-    soup.vertex.reserve(corners.size());
-    soup.source.reserve(nf);
+    pre = {};  // found for the facets as given: not the soup
+    Soup merged;
+    std::vector<int> last_facet(n, -1);  // the last facet a point was seen in, to find repeats
+    merged.vertex.reserve(corners.size());
+    merged.source.reserve(nf);
     std::vector<int> cycle, place;  // place: of a point in `cycle` while it is split (-1: none)
     for (int f = 0; f < nf; ++f) {
       cycle.clear();
@@ -1024,11 +1114,12 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
         last_facet[v] = f;
       }
       if (twice && !(fine && split_collapsed(cycle, place))) repeated = true;
-      if (cycle.size() >= 3) soup.add(cycle, f);
+      if (cycle.size() >= 3) merged.add(cycle, f);
     }
+    soup = std::move(merged);  // `corners` is not read any more
   }
   std::optional<std::pair<Soup, Connectivity>> result;
-  if (!repeated) result = simplify(points, soup, limit, true);
+  if (!repeated) result = simplify(points, soup, limit, true, std::move(pre));
   if (!result) {
     hull_fallbacks.fetch_add(1, std::memory_order_relaxed);
     Soup hull = hull_facets(points, soup);
