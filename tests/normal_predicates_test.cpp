@@ -194,19 +194,26 @@ TEST_CASE("normal predicates: orientation against an arc's plane agrees with exa
   }
 }
 
+// Pairs for the slot-plane tests: a finer sphere, a nearly identical one, and the same far
+// from unit scale and shifted (normals do not change).
+namespace {
+std::vector<std::pair<Mesh, Mesh>> slot_test_pairs() {
+  const Mesh ico1280 = sample("icosphere_1280.off");
+  return {{sample("icosphere_320.off"), ico1280},
+          {ico1280, morph::test::transformed(ico1280, small_rotation(1e-12))},
+          {morph::test::transformed(ico1280, {0x1p-200, 0, 0, 0, 0x1p-200, 0, 0, 0, 0x1p-200}),
+           morph::test::transformed(sample("icosphere_320.off"),
+                                    {0x1p200, 0, 0, 0, 0x1p200, 0, 0, 0, 0x1p200})},
+          {shifted(sample("icosphere_320.off"), 1024), shifted(ico1280, -4096)}};
+}
+}  // namespace
+
 // locate's region test reads the arc planes per fan slot, oriented as the slot runs
 // (slot_planes): the filter's decisions must be those of exact det(N_fan[s], N_fan[s+1], x),
 // also for the slots that run against their edge, on the nearest normals of a finer sphere,
 // a nearly identical one, and the same far from unit scale (normals do not change).
 TEST_CASE("normal predicates: a region's slot planes agree with exact evaluation") {
-  const Mesh ico1280 = sample("icosphere_1280.off");
-  const std::vector<std::pair<Mesh, Mesh>> pairs = {
-      {sample("icosphere_320.off"), ico1280},
-      {ico1280, morph::test::transformed(ico1280, small_rotation(1e-12))},
-      {morph::test::transformed(ico1280, {0x1p-200, 0, 0, 0, 0x1p-200, 0, 0, 0, 0x1p-200}),
-       morph::test::transformed(sample("icosphere_320.off"),
-                                {0x1p200, 0, 0, 0, 0x1p200, 0, 0, 0, 0x1p200})},
-      {shifted(sample("icosphere_320.off"), 1024), shifted(ico1280, -4096)}};
+  const std::vector<std::pair<Mesh, Mesh>> pairs = slot_test_pairs();
   for (const auto& [a, b] : pairs) {
     const Polytope A = morph::detail::make_operand(a, "A");
     const Polytope B = morph::detail::make_operand(b, "B");
@@ -244,14 +251,7 @@ TEST_CASE("normal predicates: a region's slot planes agree with exact evaluation
 // Walks from a far, fixed start and from the previous answer, on the pairs above.
 TEST_CASE("normal predicates: locate with a SlotCache answers as with slot_planes") {
   using morph::detail::Location;
-  const Mesh ico1280 = sample("icosphere_1280.off");
-  const std::vector<std::pair<Mesh, Mesh>> pairs = {
-      {sample("icosphere_320.off"), ico1280},
-      {ico1280, morph::test::transformed(ico1280, small_rotation(1e-12))},
-      {morph::test::transformed(ico1280, {0x1p-200, 0, 0, 0, 0x1p-200, 0, 0, 0, 0x1p-200}),
-       morph::test::transformed(sample("icosphere_320.off"),
-                                {0x1p200, 0, 0, 0, 0x1p200, 0, 0, 0, 0x1p200})},
-      {shifted(sample("icosphere_320.off"), 1024), shifted(ico1280, -4096)}};
+  const std::vector<std::pair<Mesh, Mesh>> pairs = slot_test_pairs();
   auto same = [](const Location& x, const Location& y) {
     return x.kind == y.kind && x.index == y.index;
   };

@@ -428,32 +428,29 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
   tbb::enumerable_thread_specific<SlotCache> slots_b([&] { return SlotCache(B); });
   const bool cache_a = cache_slots(A, nb), cache_b = cache_slots(B, na);
   const WalkStarts* starts = nullptr;  // null: each walk starts at the previous answer
-  // Translated facets: one per facet of A.
-  auto translated_facets = [&](int begin, int end, FacetBuffer& out, int& hint) {
-    SlotCache* const slots = cache_b ? &slots_b.local() : nullptr;
-    for (int f = begin; f < end; ++f) {
-      const int start = starts ? (*starts)(f) : -1;
-      if (start >= 0) hint = start;
-      const NormalRef n{&A, f};
-      loc_a[f] =
-          slots ? locate(B, *slots, n, hint, start < 0) : locate(B, nullptr, n, hint, start < 0);
-      hint = location_vertex(B, loc_a[f]);
-      facet_at_normal(A, f, B, loc_a[f], true, out);
-    }
+  // The facets of P at their normals' locations in Q's map: translated facets (P = A), one
+  // per facet of A; corner facets (P = B), one per facet of B whose normal is not also a
+  // facet normal of A.
+  auto located_facets = [&](const Polytope& P, const Polytope& Q, std::vector<Location>& loc,
+                            tbb::enumerable_thread_specific<SlotCache>& q_slots, bool cache_q) {
+    return [&, P = &P, Q = &Q, loc = loc.data(), q_slots = &q_slots, cache_q](
+               int begin, int end, FacetBuffer& out, int& hint) {
+      const bool translated = P == &A;
+      SlotCache* const slots = cache_q ? &q_slots->local() : nullptr;
+      for (int f = begin; f < end; ++f) {
+        const int start = starts ? (*starts)(f) : -1;
+        if (start >= 0) hint = start;
+        const NormalRef n{P, f};
+        loc[f] = slots ? locate(*Q, *slots, n, hint, start < 0)
+                       : locate(*Q, nullptr, n, hint, start < 0);
+        hint = location_vertex(*Q, loc[f]);
+        if (translated || loc[f].kind != Location::Kind::face)
+          facet_at_normal(*P, f, *Q, loc[f], translated, out);
+      }
+    };
   };
-  // Corner facets: one per facet of B whose normal is not also a facet normal of A.
-  auto corner_facets = [&](int begin, int end, FacetBuffer& out, int& hint) {
-    SlotCache* const slots = cache_a ? &slots_a.local() : nullptr;
-    for (int g = begin; g < end; ++g) {
-      const int start = starts ? (*starts)(g) : -1;
-      if (start >= 0) hint = start;
-      const NormalRef n{&B, g};
-      loc_b[g] =
-          slots ? locate(A, *slots, n, hint, start < 0) : locate(A, nullptr, n, hint, start < 0);
-      hint = location_vertex(A, loc_b[g]);
-      if (loc_b[g].kind != Location::Kind::face) facet_at_normal(B, g, A, loc_b[g], false, out);
-    }
-  };
+  const auto translated_facets = located_facets(A, B, loc_a, slots_b, cache_b);
+  const auto corner_facets = located_facets(B, A, loc_b, slots_a, cache_a);
   // Edge facets: for every edge of A whose two facets have different contributing
   // vertices, the edges of B whose arcs its arc crosses.
   tbb::enumerable_thread_specific<WalkScratch> scratch([&] { return WalkScratch(B); });
