@@ -490,8 +490,8 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, double 
 // When g repeats a vertex (so that these could differ from the loop's), g fails its own check
 // in nondegenerate(), and that failure is the verdict whatever the reflex flag says.
 template <class Height>
-bool reflex_across_small(const MeshView& m, const FaceCycles& cycles, const Height& height, int g,
-                         int from, int to, double tolerance) {
+inline bool reflex_across_small(const MeshView& m, const FaceCycles& cycles, const Height& height,
+                                int g, int from, int to, double tolerance) {
   const int gb = cycles.begin[g];
   const int* corners = cycles.vertex + gb;
   const int n = cycles.begin[g + 1] - gb;
@@ -531,6 +531,14 @@ struct QuadPlane {
   double nx, ny, nz;     // the unit normal
   double first, second;  // six times the volumes of the fan's two tetrahedra
   bool ok;               // false: a repeated vertex or position, or zero area (nothing else is set)
+};
+
+// height(plane, p) of a plane given by its centroid and unit normal: the same operations.
+struct PlaneHeight {
+  double cx, cy, cz, nx, ny, nz;
+  double operator()(const Point& p) const {
+    return (p[0] - cx) * nx + (p[1] - cy) * ny + (p[2] - cz) * nz;
+  }
 };
 
 QuadPlane quad_plane(const MeshView& m, const int* ids, double zero_area, const Point& centre,
@@ -598,11 +606,9 @@ bool quad_passes(const MeshView& m, const FaceCycles& cycles, int f, const QuadP
   const int* ids = cycles.vertex + b;
   const int i0 = ids[0], i1 = ids[1], i2 = ids[2], i3 = ids[3];
   const Point &p0 = m.points[i0], &p1 = m.points[i1], &p2 = m.points[i2], &p3 = m.points[i3];
-  // height(plane, p): dot(p - centroid, normal), summed in OpenMesh's order.
-  const double cx = q.cx, cy = q.cy, cz = q.cz, nx = q.nx, ny = q.ny, nz = q.nz;
-  const auto height = [&](const Point& p) {
-    return (p[0] - cx) * nx + (p[1] - cy) * ny + (p[2] - cz) * nz;
-  };
+  // height(plane, p): dot(p - centroid, normal), summed in OpenMesh's order (a value, not a
+  // closure over references: the calls below inline it).
+  const PlaneHeight height{q.cx, q.cy, q.cz, q.nx, q.ny, q.nz};
   if (non_planar_face < 0 &&
       !(std::abs(height(p0)) <= tolerance && std::abs(height(p1)) <= tolerance &&
         std::abs(height(p2)) <= tolerance && std::abs(height(p3)) <= tolerance))
