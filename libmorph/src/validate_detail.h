@@ -82,10 +82,10 @@ struct UnitNormal;  // polytope.h
 
 /// geometry_passes(mesh, cycles) (the default tolerance) that also, when it returns true, fills
 /// unit_normals[f] (F entries) with face f's unit normal and a bound on its distance to the
-/// direction of the face's exact Newell normal (Polytope::unit_normals), from the plane the
-/// checks computed anyway: the same direction and the same kind of bound as
-/// Polytope::compute_normals() gives. `complete` is false when some face's normal is too long
-/// or too short for that (then the caller computes them all itself).
+/// direction of the face's exact Newell normal (centroid_unit_normal() of the plane the checks
+/// computed anyway): the values Polytope::compute_normals() gives a facet with this cycle.
+/// `complete` is false when some face's Newell sum is out of that function's range (then the
+/// caller computes them all itself).
 bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles, UnitNormal* unit_normals,
                      bool& complete);
 
