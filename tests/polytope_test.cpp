@@ -543,6 +543,70 @@ TEST_CASE("polytope: a within_error oracle that can fail") {
 
 namespace {
 
+// make_operand's checked path takes its unit normals from the operand check's planes: they must
+// be compute_normals()'s (the same values whichever path builds the polytope), each within its
+// bound of the exact direction.
+void check_operand_normals(const Mesh& mesh, const std::string& what) {
+  CAPTURE(what);
+  tbb::task_arena one(1);  // the checked path in sequence: the check's normals
+  Polytope p;
+  one.execute([&] { p = morph::detail::make_operand(mesh, "A"); });
+  const Polytope general = morph::detail::make_polytope(mesh, "A");
+  CHECK(difference(p, general) == "");
+  for (int f = 0; f < p.num_faces(); ++f) {
+    CAPTURE(f);
+    CHECK(within_error(p.unit_normals[f], p.exact_normal(f)));
+  }
+}
+
+}  // namespace
+
+TEST_CASE("polytope: make_operand's unit normals from the check are compute_normals'") {
+  for (const auto& entry : std::filesystem::directory_iterator(MORPH_SAMPLES_DIR)) {
+    if (entry.path().extension() != ".off") continue;
+    const std::string name = entry.path().filename().string();
+    const Mesh mesh = morph::read_mesh(entry.path().string());
+    check_operand_normals(mesh, name);
+    check_operand_normals(morph::test::transformed(mesh, morph::test::random_rotation(7)),
+                          name + " rotated");
+    // Tiny and huge: Newell sums outside centroid_unit_normal()'s range (the check then
+    // leaves the normals to compute_normals()).
+    check_operand_normals(morph::test::scaled(mesh, 0x1p-200), name + " tiny");
+    check_operand_normals(morph::test::scaled(mesh, 0x1p200), name + " huge");
+    check_operand_normals(morph::test::translated(mesh, Point(1e6, -3e5, 7)), name + " far");
+  }
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    check_operand_normals(morph::test::random_sphere_polytope(300, seed),
+                          "sphere " + std::to_string(seed));
+    check_operand_normals(morph::test::rotated_cube_quads(2.0, seed),
+                          "quads " + std::to_string(seed));
+  }
+  // Slivers: a triangle and a quadrilateral barely above the check's zero area (1e-14 D^2),
+  // where the bound is wide, each also scaled by 2^+-200 and shifted far.
+  for (const double thin : {3e-14, 1e-13, 1e-9}) {
+    const std::vector<Point> tet = {{0, 0, 0}, {1, 0, 0}, {0.5, thin, 0}, {0.4, 0.3, 1}};
+    const Mesh sliver =
+        morph::test::mesh_from_polygons(tet, {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {2, 0, 3}});
+    const std::vector<Point> wedge = {
+        {0, 0, 0}, {1, 0, 0}, {1, thin, 0}, {0, thin, 0}, {0.5, 0.2, 1}};
+    const Mesh flat_quad = morph::test::mesh_from_polygons(
+        wedge, {{0, 3, 2, 1}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}});
+    for (const Mesh* m : {&sliver, &flat_quad}) {
+      const std::string what = (m == &sliver ? "sliver " : "thin quad ") + std::to_string(thin);
+      check_operand_normals(*m, what);
+      check_operand_normals(morph::test::scaled(*m, 0x1p-200), what + " tiny");
+      check_operand_normals(morph::test::scaled(*m, 0x1p200), what + " huge");
+      // (Not the thin quadrilateral, whose sides are needles that a shift's rounding makes
+      // non-planar; nor so far that it rounds the sliver's width much.)
+      const double far = thin < 1e-10 ? 1 : 1e3;
+      if (m == &sliver)
+        check_operand_normals(morph::test::translated(*m, Point(far, -far, far)), what + " far");
+    }
+  }
+}
+
+namespace {
+
 // The exact sign of det(N_left, N_right, to - from) of edge e (double points).
 int exact_edge_convexity(const Polytope& p, int e) {
   const auto& edge = p.edges[e];

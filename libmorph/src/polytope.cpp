@@ -204,47 +204,49 @@ inline UnitNormal normalised(V3<double> m, double radius) {
   return {m.x * inverse, m.y * inverse, m.z * inverse, error};
 }
 
-/// Facet f's Newell normal computed in doubles from its double points, as a sum of cross
-/// products of the corners relative to the first, a_k = p_k - p_0 (the same polynomial:
-/// Newell's sum is translation invariant, and the terms at a_0 = 0 vanish), with a bound
-/// on each component's error. Rounding each difference, product and sum within one ulp
-/// (any rounding mode), a term a_j b_l - a_l b_j errs by at most 4 ulps of
-/// |a_j b_l| + |a_l b_j| and each of the d - 3 additions by one ulp of the sum of those:
-/// (d + 1) ulps of M in all, taken as (d + 2) with a margin for M's own rounding, plus
-/// an absolute term for underflow.
+/// Facet f's unit normal from its double points: centroid_unit_normal() of its Newell sum
+/// relative to its centroid, in the operations of the operand check's planes (validate.cpp:
+/// newell_plane(), the unrolled triangles and quadrilaterals, and the magnitude beside them),
+/// so that make_operand takes the check's values instead of computing them again and every
+/// path gives the same. Where that function refuses (|n| far from 1), normalised() with the
+/// same radius.
 UnitNormal unit_newell(const std::vector<V3<double>>& points, const int* corners, int d) {
-  const V3<double>& o = points[corners[0]];
-  V3<double> sum{0, 0, 0}, magnitude{0, 0, 0};
-  V3<double> a = points[corners[1]] - o;
-  if (d == 3) {
-    // The loop below run once, written out (most facets are triangles): the same values.
-    const V3<double> b = points[corners[2]] - o;
-    const double xy = a.y * b.z, xz = a.z * b.y, yz = a.z * b.x, yx = a.x * b.z, zx = a.x * b.y,
-                 zy = a.y * b.x;
-    sum = {0.0 + (xy - xz), 0.0 + (yz - yx), 0.0 + (zx - zy)};
-    const double factor = 5 * kUlp * 1.01, absolute = 3 * 0x1p-1000;
-    return normalised(sum, (factor * ((0.0 + (std::abs(xy) + std::abs(xz))) +
-                                      (0.0 + (std::abs(yz) + std::abs(yx))) +
-                                      (0.0 + (std::abs(zx) + std::abs(zy)))) +
-                            3 * absolute) *
-                               1.01);
+  double cx = 0.0, cy = 0.0, cz = 0.0;
+  for (int k = 0; k < d; ++k) {
+    const V3<double>& p = points[corners[k]];
+    cx += p.x;
+    cy += p.y;
+    cz += p.z;
   }
-  for (int k = 2; k < d; ++k) {
-    const V3<double> b = points[corners[k]] - o;
-    const double xy = a.y * b.z, xz = a.z * b.y, yz = a.z * b.x, yx = a.x * b.z, zx = a.x * b.y,
-                 zy = a.y * b.x;
-    sum.x += xy - xz;
-    sum.y += yz - yx;
-    sum.z += zx - zy;
-    magnitude.x += std::abs(xy) + std::abs(xz);
-    magnitude.y += std::abs(yz) + std::abs(yx);
-    magnitude.z += std::abs(zx) + std::abs(zy);
-    a = b;
+  const double scale = 1.0 / d;
+  cx *= scale;
+  cy *= scale;
+  cz *= scale;
+  double nx = 0.0, ny = 0.0, nz = 0.0, magnitude = 0.0;
+  const V3<double>& p0 = points[corners[0]];
+  const double a0[3] = {p0.x - cx, p0.y - cy, p0.z - cz};
+  const double l0 = norm1(a0[0], a0[1], a0[2]);
+  double ax = a0[0], ay = a0[1], az = a0[2], la = l0;
+  for (int k = 0; k < d; ++k) {
+    double bx, by, bz, lb;
+    if (k + 1 == d) {
+      bx = a0[0], by = a0[1], bz = a0[2], lb = l0;
+    } else {
+      const V3<double>& q = points[corners[k + 1]];
+      bx = q.x - cx, by = q.y - cy, bz = q.z - cz;
+      lb = norm1(bx, by, bz);
+    }
+    nx += ay * bz - az * by;
+    ny += az * bx - ax * bz;
+    nz += ax * by - ay * bx;
+    magnitude += la * lb;
+    ax = bx, ay = by, az = bz, la = lb;
   }
-  const double factor = (d + 2) * kUlp * 1.01, absolute = d * 0x1p-1000;
-  // The bound of each component, summed: a bound on the Euclidean distance.
-  return normalised(sum,
-                    (factor * (magnitude.x + magnitude.y + magnitude.z) + 3 * absolute) * 1.01);
+  const double length = std::sqrt((nx * nx + ny * ny) + nz * nz);
+  UnitNormal u;
+  if (centroid_unit_normal(nx, ny, nz, length, 1.0 / length, magnitude, d, u)) return u;
+  return normalised({nx, ny, nz},
+                    ((d + 4) * kUlp * 1.01 * magnitude + 3 * d * 0x1p-1000) * 1.01);
 }
 
 /// The unit normal of an interval enclosure n of a facet's Newell normal: its midpoint m,
@@ -259,10 +261,12 @@ UnitNormal unit_of_enclosure(const V3<Interval>& n) {
 
 }  // namespace
 
-void Polytope::compute_normals() {
+void Polytope::compute_normals(bool units_known) {
   const int nf = num_faces();
   unit_normals.resize(nf);
-  if (exact_points.empty()) {
+  if (units_known) {
+    // Nothing to compute.
+  } else if (exact_points.empty()) {
     for (int f = 0; f < nf; ++f)
       unit_normals[f] = unit_newell(points, &corner_vertex[face_begin[f]], degree(f));
   } else {
@@ -1173,9 +1177,10 @@ namespace {
 /// make_polytope(mesh, name, order) once connectivity_from_halfedges has filled p's facets,
 /// edges and fans: the normals, the canonical form, the labels and the Gauss map. The facet
 /// cycles are only read (they end in the result, or stay in p).
+/// `units_known`: p.unit_normals already holds the facets' unit normals.
 Polytope finish_from_halfedges(Polytope& p, std::vector<int> mesh_edge, const Mesh& mesh,
-                               const char* name, FaceOrder order) {
-  p.compute_normals();
+                               const char* name, FaceOrder order, bool units_known = false) {
+  p.compute_normals(units_known);
   if (!is_canonical(p)) return make_polytope_from_cycles(mesh, name, order);
   p.vertex_source.resize(p.num_vertices());
   std::iota(p.vertex_source.begin(), p.vertex_source.end(), 0);
@@ -1237,13 +1242,14 @@ std::optional<Polytope> checked_polytope(const Mesh& mesh, const char* name) {
   // The geometric checks and the rest of the build both only read the facet cycles. The
   // check's verdict decides, as in make_operand.
   std::atomic<bool> rejected{false};
-  bool passes = false, walked = false;
+  bool passes = false, walked = false, units_known = false;
   std::optional<Polytope> built;
   std::exception_ptr build_error;
   const auto build = [&] {
     if (rejected) return;
     try {
-      built = finish_from_halfedges(p, std::move(mesh_edge), mesh, name, FaceOrder::as_given);
+      built = finish_from_halfedges(p, std::move(mesh_edge), mesh, name, FaceOrder::as_given,
+                                    units_known);
     } catch (...) {
       build_error = std::current_exception();
     }
@@ -1265,11 +1271,14 @@ std::optional<Polytope> checked_polytope(const Mesh& mesh, const char* name) {
           if (walked) build();
         });
   } else {
-    // In sequence, the check on the walks' cycles (read once), before the build.
+    // In sequence, the check on the walks' cycles (read once), before the build; the check
+    // leaves the facets' unit normals from the planes it computes (the facets are the faces,
+    // the cycles the same), so the build need not compute them again.
     walked = walk() && topology.passes;
     if (!walked) return std::nullopt;
     const FaceCycleView cycles{p.face_begin.data(), p.corner_vertex.data(), topology.across.data()};
-    passes = geometry_passes(mesh, cycles);
+    p.unit_normals.resize(p.num_faces());
+    passes = geometry_passes(mesh, cycles, p.unit_normals.data(), units_known);
     rejected = !passes;
     build();
   }

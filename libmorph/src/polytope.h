@@ -20,7 +20,9 @@
 #include <morph/mesh.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -34,6 +36,36 @@ namespace morph::detail {
 struct UnitNormal {
   double x, y, z, error;
 };
+
+/// |x| + |y| + |z|.
+inline double norm1(double x, double y, double z) {
+  return std::abs(x) + std::abs(y) + std::abs(z);
+}
+
+/// A facet's unit normal from its Newell sum n = (nx, ny, nz) computed in doubles relative to
+/// the rounded centroid c of its d corners (Newell's sum is translation invariant: the exact
+/// sum relative to c is the facet's exact normal), over the rounded corners a_k = fl(p_k - c),
+/// summed from zero in corner order; length = sqrt(n.n) and inverse = 1 / length as rounded,
+/// and magnitude = sum over the edges a-b of |a|_1 |b|_1 (rounded). The bound: each a_k is
+/// within one ulp of p_k - c, so each term a_j b_l - a_l b_j of a cross product is within 4
+/// ulps of |a_j b_l| + |a_l b_j| (two inputs, the product, the difference), and each of the
+/// d - 1 rounded additions (the first adds to zero) within one ulp of the sum of those: (d + 3)
+/// ulps of M in all components together, where M = sum over the edges of
+/// sum_(j != l) |a_j| |b_l| <= magnitude; taken as d + 4 with margins for the rounding of M,
+/// plus an absolute term for underflow. Then, as normalised() in polytope.cpp, n * inverse
+/// lies within 2 radius / |n| (plus a few ulps) of the direction of any vector within radius
+/// of n. Any rounding mode (ulps of 2^-52). False (nothing set) when |n| lies where n.n could
+/// overflow or underflow (normalised() scales n first). The operand check computes these values
+/// beside its own (see geometry_passes) and Polytope::compute_normals() the same.
+inline bool centroid_unit_normal(double nx, double ny, double nz, double length, double inverse,
+                                 double magnitude, int d, UnitNormal& out) {
+  if (!(length > 1e-100 && length < 1e100)) return false;
+  const double radius = ((d + 4) * 0x1p-52 * 1.01 * magnitude + 3 * d * 0x1p-1000) * 1.01;
+  double error = 2 * radius * inverse * (1 + 1e-10) + 4e-15;
+  if (!std::isfinite(error) || error > 1) error = std::numeric_limits<double>::infinity();
+  out = {nx * inverse, ny * inverse, nz * inverse, error};
+  return true;
+}
 
 /// A facet normal in double-double arithmetic (component i is hi[i] + lo[i]), times some
 /// power of two, within error[i] of the exact normal times that power in component i (a
@@ -172,8 +204,9 @@ struct Polytope {
   const V3<ExactN>& exact_normal(int f) const;
 
   /// Computes `unit_normals` and resets the caches of exact and precise normals; call
-  /// after the facets are final.
-  void compute_normals();
+  /// after the facets are final. `units_known`: `unit_normals` already holds every facet's
+  /// (make_operand's check computed them, see geometry_passes): only the caches are reset.
+  void compute_normals(bool units_known = false);
 
   /// Facet f's exact normal (the given one, or Newell's of the double points) in
   /// double-double arithmetic, scaled by a power of two, with an error bound: the second

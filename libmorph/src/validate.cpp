@@ -12,11 +12,13 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "polytope.h"
 #include "validate_detail.h"
 
 namespace morph {
@@ -337,7 +339,23 @@ struct Geometry {
   FanVolumes volumes;
   int non_planar_face = -1;
   bool reflex = false;  // some vertex lies above the plane of a neighbouring face
+  // Optional (null: none): where each face's unit normal goes (see unit_normal()), and
+  // whether every face's could be given.
+  detail::UnitNormal* unit = nullptr;
+  bool unit_complete = true;
 };
+
+// The unit normal that a face's checks leave for the polytope: detail::centroid_unit_normal()
+// of the face's Newell sum as they computed it (the same operations as
+// Polytope::compute_normals(), so the same values). `complete` turns false when the sum is
+// out of that function's range: the caller then computes every unit normal itself.
+inline void unit_normal(detail::UnitNormal& out, double nx, double ny, double nz, double length,
+                        double inverse, double magnitude, int d, bool& complete) {
+  if (!detail::centroid_unit_normal(nx, ny, nz, length, inverse, magnitude, d, out))
+    complete = false;
+}
+
+using detail::norm1;
 
 // The plane of face f with its unit normal (the face is known to be non-degenerate).
 FacePlane unit_plane(const MeshView& m, const FaceCycles& cycles, int f) {
@@ -385,7 +403,8 @@ bool has_equal_pair(int n, const Key& key) {
 // names the problem.
 bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, double tolerance,
                      double zero_area, bool convexity, const Point& centre, FanVolumes& volumes,
-                     int& non_planar_face, bool& any_reflex) {
+                     int& non_planar_face, bool& any_reflex, detail::UnitNormal* unit,
+                     bool& unit_complete) {
   const int b = cycles.begin[f];
   const int* ids = cycles.vertex + b;
   const int i0 = ids[0], i1 = ids[1], i2 = ids[2];
@@ -410,6 +429,11 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, double 
   const double length = std::sqrt((nx * nx + ny * ny) + nz * nz);
   if (!(length > zero_area)) return false;
   const double inverse = 1.0 / length;
+  if (unit) {
+    const double la = norm1(ax, ay, az), lb = norm1(bx, by, bz), lq = norm1(qx, qy, qz);
+    unit_normal(*unit, nx, ny, nz, length, inverse, (la * lb + lb * lq) + lq * la, 3,
+                unit_complete);
+  }
   nx *= inverse;
   ny *= inverse;
   nz *= inverse;
@@ -466,8 +490,8 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, double 
 // When g repeats a vertex (so that these could differ from the loop's), g fails its own check
 // in nondegenerate(), and that failure is the verdict whatever the reflex flag says.
 template <class Height>
-bool reflex_across_small(const MeshView& m, const FaceCycles& cycles, const Height& height, int g,
-                         int from, int to, double tolerance) {
+inline bool reflex_across_small(const MeshView& m, const FaceCycles& cycles, const Height& height,
+                                int g, int from, int to, double tolerance) {
   const int gb = cycles.begin[g];
   const int* corners = cycles.vertex + gb;
   const int n = cycles.begin[g + 1] - gb;
@@ -509,7 +533,16 @@ struct QuadPlane {
   bool ok;               // false: a repeated vertex or position, or zero area (nothing else is set)
 };
 
-QuadPlane quad_plane(const MeshView& m, const int* ids, double zero_area, const Point& centre) {
+// height(plane, p) of a plane given by its centroid and unit normal: the same operations.
+struct PlaneHeight {
+  double cx, cy, cz, nx, ny, nz;
+  double operator()(const Point& p) const {
+    return (p[0] - cx) * nx + (p[1] - cy) * ny + (p[2] - cz) * nz;
+  }
+};
+
+QuadPlane quad_plane(const MeshView& m, const int* ids, double zero_area, const Point& centre,
+                     detail::UnitNormal* unit, bool& unit_complete) {
   QuadPlane q;
   q.ok = false;
   const int i0 = ids[0], i1 = ids[1], i2 = ids[2], i3 = ids[3];
@@ -535,6 +568,12 @@ QuadPlane quad_plane(const MeshView& m, const int* ids, double zero_area, const 
   const double length = std::sqrt((nx * nx + ny * ny) + nz * nz);
   if (!(length > zero_area)) return q;
   const double inverse = 1.0 / length;
+  if (unit) {
+    const double la = norm1(ax, ay, az), lb = norm1(bx, by, bz), lq = norm1(qx, qy, qz),
+                 lr = norm1(rx, ry, rz);
+    unit_normal(*unit, nx, ny, nz, length, inverse, ((la * lb + lb * lq) + lq * lr) + lr * la, 4,
+                unit_complete);
+  }
   q.cx = cx;
   q.cy = cy;
   q.cz = cz;
@@ -567,11 +606,9 @@ bool quad_passes(const MeshView& m, const FaceCycles& cycles, int f, const QuadP
   const int* ids = cycles.vertex + b;
   const int i0 = ids[0], i1 = ids[1], i2 = ids[2], i3 = ids[3];
   const Point &p0 = m.points[i0], &p1 = m.points[i1], &p2 = m.points[i2], &p3 = m.points[i3];
-  // height(plane, p): dot(p - centroid, normal), summed in OpenMesh's order.
-  const double cx = q.cx, cy = q.cy, cz = q.cz, nx = q.nx, ny = q.ny, nz = q.nz;
-  const auto height = [&](const Point& p) {
-    return (p[0] - cx) * nx + (p[1] - cy) * ny + (p[2] - cz) * nz;
-  };
+  // height(plane, p): dot(p - centroid, normal), summed in OpenMesh's order (a value, not a
+  // closure over references: the calls below inline it).
+  const PlaneHeight height{q.cx, q.cy, q.cz, q.nx, q.ny, q.nz};
   if (non_planar_face < 0 &&
       !(std::abs(height(p0)) <= tolerance && std::abs(height(p1)) <= tolerance &&
         std::abs(height(p2)) <= tolerance && std::abs(height(p3)) <= tolerance))
@@ -616,20 +653,23 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
   int non_planar_face = geometry.non_planar_face;
   bool reflex = geometry.reflex;
   const Point centre = geometry.extent.centre;
+  detail::UnitNormal* const unit = geometry.unit;
+  bool unit_complete = geometry.unit_complete;
   // Every live quadrilateral's plane first (quad_plane() changes nothing); none when there
-  // are no quadrilaterals.
-  std::vector<QuadPlane> quad_planes;
+  // are no quadrilaterals (default-initialised: only quadrilaterals' entries are read).
+  std::unique_ptr<QuadPlane[]> quad_planes;
   for (int f = 0; f < m.n_faces && shortcuts; ++f) {
     if (geometry.cycles.degree(f) != 4 || !m.live_face(f)) continue;
-    if (quad_planes.empty()) quad_planes.resize(m.n_faces);
-    quad_planes[f] = quad_plane(m, geometry.cycles.corners(f), zero_area, centre);
+    if (!quad_planes) quad_planes.reset(new QuadPlane[m.n_faces]);
+    quad_planes[f] = quad_plane(m, geometry.cycles.corners(f), zero_area, centre,
+                                unit ? unit + f : nullptr, unit_complete);
   }
   for (int f = 0; f < m.n_faces; ++f) {
     if (!m.live_face(f)) continue;
     const int n = geometry.cycles.degree(f);
     if (n == 3 && shortcuts &&
         triangle_passes(m, geometry.cycles, f, tolerance, zero_area, convexity, centre, volumes,
-                        non_planar_face, reflex))
+                        non_planar_face, reflex, unit ? unit + f : nullptr, unit_complete))
       continue;
     if (n == 4 && shortcuts &&
         quad_passes(m, geometry.cycles, f, quad_planes[f], tolerance, convexity, volumes,
@@ -653,6 +693,22 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
     const double length = plane.normal.norm();
     if (!(length > zero_area))
       return fail(Verdict::invalid, face() + " has zero area (its vertices are collinear)");
+    if (unit) {
+      // The corners relative to the centroid, as newell_plane() computed them.
+      double magnitude = 0, first = 0, previous = 0;
+      for (int k = 0; k < n; ++k) {
+        const Point a = m.points[ids[k]] - plane.centroid;
+        const double l = norm1(a[0], a[1], a[2]);
+        if (k == 0)
+          first = l;
+        else
+          magnitude += previous * l;
+        previous = l;
+      }
+      magnitude += previous * first;
+      unit_normal(unit[f], plane.normal[0], plane.normal[1], plane.normal[2], length, 1.0 / length,
+                  magnitude, n, unit_complete);
+    }
     plane.normal *= 1.0 / length;
     volumes.add_face(m.points, ids, n, centre);
     for (int k = 0; k < n && non_planar_face < 0; ++k)
@@ -667,6 +723,7 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
   geometry.volumes = volumes;
   geometry.non_planar_face = non_planar_face;
   geometry.reflex = reflex;
+  geometry.unit_complete = unit_complete;
   return {};
 }
 
@@ -829,6 +886,19 @@ bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles, double plana
   geometry.cycles.vertex = cycles.vertex;
   geometry.cycles.across = cycles.across;
   return geometry_of_cycles_passes(m, geometry, planarity_tolerance);
+}
+
+bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles, UnitNormal* unit_normals,
+                     bool& complete) {
+  const MeshView m(mesh, true);  // the caller's precondition
+  Geometry geometry;
+  geometry.cycles.begin = cycles.begin;
+  geometry.cycles.vertex = cycles.vertex;
+  geometry.cycles.across = cycles.across;
+  geometry.unit = unit_normals;
+  const bool passes = geometry_of_cycles_passes(m, geometry, kPlanarityTolerance);
+  complete = geometry.unit_complete;
+  return passes;
 }
 
 std::string convex_polyhedron_problem(const Mesh& mesh, double planarity_tolerance,

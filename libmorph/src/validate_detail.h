@@ -78,6 +78,17 @@ struct FaceCycleView {
 bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles,
                      double planarity_tolerance = kPlanarityTolerance);
 
+struct UnitNormal;  // polytope.h
+
+/// geometry_passes(mesh, cycles) (the default tolerance) that also, when it returns true, fills
+/// unit_normals[f] (F entries) with face f's unit normal and a bound on its distance to the
+/// direction of the face's exact Newell normal (centroid_unit_normal() of the plane the checks
+/// computed anyway): the values Polytope::compute_normals() gives a facet with this cycle.
+/// `complete` is false when some face's Newell sum is out of that function's range (then the
+/// caller computes them all itself).
+bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles, UnitNormal* unit_normals,
+                     bool& complete);
+
 /// geometry_passes(mesh, cycles) on the face cycles read here from the mesh (check_operand's),
 /// for a caller that checks beside the halfedge walks that would give them: the same verdict
 /// whenever the mesh passes check_operand's topological checks. Only for a mesh without deleted
