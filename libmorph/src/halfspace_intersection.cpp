@@ -2061,6 +2061,7 @@ struct PolygonScratch {
   std::vector<V3<Interval>> cross;           // n_i x n_j of positions i, j (k i + j)
   std::vector<char> has_cross;
   std::vector<signed char> diagonal_side;  // of diagonal i, j (k i + j, i < j), or 2
+  std::vector<int> owner;  // 3 t + slot of the triangle t holding edge i -> j (k i + j), or -1
 };
 
 /// Flips per corner after which a polygon's triangulation gives up: Lawson's flips may
@@ -2108,8 +2109,18 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
   auto& pending = scratch.pending;
   triangle.clear();
   pending.clear();
+  auto& owner = scratch.owner;
+  owner.assign(static_cast<std::size_t>(k) * k, -1);
+  // Triangle t's corners and the owner of each of its edges.
+  const auto set_triangle = [&](int t, int x, int y, int z) {
+    triangle[t] = {x, y, z};
+    owner[x * k + y] = 3 * t;
+    owner[y * k + z] = 3 * t + 1;
+    owner[z * k + x] = 3 * t + 2;
+  };
   for (int i = 1; i + 1 < k; ++i) {
-    triangle.push_back({0, i, i + 1});
+    triangle.emplace_back();
+    set_triangle(i - 1, 0, i, i + 1);
     if (i > 1) pending.emplace_back(0, i);
   }
   ready.assign(triangle.size(), 0);
@@ -2133,7 +2144,8 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
     scratch.has_cross[i * k + j] = 1;
     return c;
   };
-  // Triangle t's vertex, as vertex_of(planes, abc, known) computes it.
+  // Triangle t's vertex, as vertex_of(planes, abc, known) computes it but for xi, which
+  // the flips' tests do not use: made for the final triangles only.
   const auto compute_vertex = [&](int t) {
     ready[t] = 1;
     const auto [i, j, l] = triangle[t];
@@ -2145,8 +2157,7 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
     const Plane &a = planes[p[i]], &b = planes[p[j]], &c = planes[p[l]];
     meet_of_crosses(a.ni, a.di, b.di, c.di, cross_of(j, l), cross_of(l, i), cross_of(i, j), v.Xi,
                     v.Wi);
-    v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
-    take_known(known, v);
+    take_known(known, v);  // (a known point's xi is set)
   };
   // Triangle t's vertex (computed when first tested); false when t is not positively
   // oriented.
@@ -2158,10 +2169,9 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
   };
   // The triangle holding the directed edge a -> c and that edge's slot in it, or -1.
   const auto find = [&](int a, int c, int& slot) {
-    for (int t = 0; t < static_cast<int>(triangle.size()); ++t)
-      for (slot = 0; slot < 3; ++slot)
-        if (triangle[t][slot] == a && triangle[t][(slot + 1) % 3] == c) return t;
-    return -1;
+    const int o = owner[a * k + c];
+    slot = o % 3;
+    return o < 0 ? -1 : o / 3;
   };
   const auto side_of = [&](int plane, HVertex& v) {
     return known_through(known, p[plane], v) ? 0 : side(planes, precise, p[plane], v);
@@ -2177,15 +2187,23 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
     const int t = find(a, c, i), u = find(c, a, j);
     if (t < 0 || u < 0) continue;  // flipped away meanwhile
     const int b = triangle[t][(i + 2) % 3], d = triangle[u][(j + 2) % 3];
-    if (!make_vertex(t)) return false;
-    const int sd = side_of(d, vertex[t]);
+    // Plane d at t's vertex, or the same sign from the other side when only u's is made:
+    // plane b at the vertex of u = (c, a, d) (see build_verified's far-plane tests).
+    int sd;
+    if (!ready[t] && ready[u]) {
+      sd = side_of(b, vertex[u]);
+    } else {
+      if (!make_vertex(t)) return false;
+      sd = side_of(d, vertex[t]);
+    }
     if (sd <= 0) {
       diagonal_side(a, c) = static_cast<signed char>(sd);
       continue;
     }
     if (++flips > kFlipsPerCorner * k) return false;
-    triangle[t] = {a, d, b};
-    triangle[u] = {d, c, b};
+    owner[a * k + c] = owner[c * k + a] = -1;
+    set_triangle(t, a, d, b);
+    set_triangle(u, d, c, b);
     ready[t] = ready[u] = 0;
     diagonal_side(b, d) = -1;
     // The quadrilateral's sides have a new triangle each: tested again where diagonals.
@@ -2204,6 +2222,8 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
       out_far[3 * t + m] = diagonal(x, y) ? diagonal_side(x, y) : 2;
     }
     if (!ready[t]) compute_vertex(static_cast<int>(t));
+    HVertex& v = vertex[t];
+    if (v.known < 0) v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
     out_has[t] = 1;
   }
   return true;
