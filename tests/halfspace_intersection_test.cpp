@@ -1215,3 +1215,64 @@ TEST_CASE("halfspace_intersection: a triangle's double-double normal is within i
   CHECK(set > 0);
   MESSAGE("double-double normals set for " << set << " of " << total << " triangles");
 }
+
+// The check's far-plane tests of an edge are one sign, which it and the guess's flips reuse
+// (build_verified, triangulate_polygon): plane d at the vertex of (a, b, c) and plane c at
+// that of (b, a, d) (the same edge seen from its other triangle) have the same sign, any
+// rotation of a triangle's corners gives the same vertex, and after the flip of edge a -> c
+// of (a, c, b) to (b, d) the new edge's test, plane c at the vertex of (a, d, b), has the
+// sign opposite to the flipped one's (d at the vertex of (a, c, b)).
+// Exact evaluation (Cramer's rule in Mpzf) on four planes nearly through one point (the
+// flips' ties), exactly through it, and generic, scaled by 2^+-200 and far from the origin.
+TEST_CASE("halfspace_intersection: an edge's two far-plane tests are one sign") {
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  struct P {
+    V3<ExactN> n;
+    ExactN d;
+  };
+  // Sign of <n_e, X> - d_e W for X / W the meet of a, b, c (W = det(n_a, n_b, n_c)).
+  const auto side = [](const P& a, const P& b, const P& c, const P& e) {
+    const V3<ExactN> bc = cross(b.n, c.n), ca = cross(c.n, a.n), ab = cross(a.n, b.n);
+    const ExactN W = dot(a.n, bc);
+    const V3<ExactN> X{a.d * bc.x + b.d * ca.x + c.d * ab.x, a.d * bc.y + b.d * ca.y + c.d * ab.y,
+                       a.d * bc.z + b.d * ca.z + c.d * ab.z};
+    return CGAL::sign(dot(e.n, X) - e.d * W);
+  };
+  int zeros = 0, total = 0;
+  for (int scale : {0, 200, -200}) {
+    for (double shift : {0.0, 1e6, -3e9}) {
+      for (int kind = 0; kind < 3; ++kind) {  // through a point, nearly, generic
+        for (int trial = 0; trial < 100; ++trial) {
+          const V3<double> o{shift + unit(rng), shift + unit(rng), unit(rng)};
+          std::array<P, 4> q;
+          for (P& p : q) {
+            const V3<double> n{unit(rng), unit(rng), unit(rng)};
+            p.n = to_exact_n(n);
+            // Through o, exactly, or moved by 2^-60 of its offset, or anywhere.
+            const V3<double> at =
+                kind == 2 ? V3<double>{shift + unit(rng), unit(rng), unit(rng)} : o;
+            p.d = dot(p.n, to_exact_n(at));
+            if (kind == 1) p.d = p.d + ExactN(std::ldexp(unit(rng), -60)) * p.d;
+            const ExactN s(std::ldexp(1.0, scale));
+            p.d = p.d * s;  // the planes scaled by 2^scale about the origin
+          }
+          const auto& [a, b, c, d] = q;
+          const int s = side(a, b, c, d);
+          CHECK(side(b, a, d, c) == s);
+          CHECK(side(b, c, a, d) == s);  // a rotation of (a, b, c)
+          // The flip of edge a -> c between (a, c, b) and (c, a, d) to (a, d, b), (d, c, b).
+          const int f = side(a, c, b, d);
+          CHECK(side(c, a, d, b) == f);
+          CHECK(side(a, d, b, c) == -f);  // the new edge d -> b of (a, d, b), far c
+          CHECK(side(d, b, a, c) == -f);  // the same triangle rotated
+          CHECK(side(d, c, b, a) == -f);  // its twin in (d, c, b): edge b -> d, far a
+          zeros += s == 0;
+          ++total;
+        }
+      }
+    }
+  }
+  CHECK(zeros > 0);
+  CHECK(zeros < total);
+}

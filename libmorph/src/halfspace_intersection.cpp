@@ -189,8 +189,9 @@ struct DualSurface {
   // Empty, or per plane: a triangle near the plane's dual point, for one that is not on the
   // surface (removed by a repair), where the check's climb starts; -1 where none is known.
   std::vector<int> near;
-  // Set by a repair: every triangle is known positively oriented, and far_side (3 per
-  // triangle: the check's far-plane signs, or 2 where not known) holds those of the
+  // Set by a repair: every triangle is known positively oriented. far_side (3 per
+  // triangle, or empty): the check's far-plane signs where known, else 2; a guess knows
+  // those of its polygons' diagonals (triangulate_polygon), a repair those of the
   // triangles it left, with the same neighbours.
   bool oriented = false;
   std::vector<signed char> far_side;
@@ -1135,21 +1136,51 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   // tested there), with independent normals (det > 0 above), so its vertex is that point
   // and the signs are the group's. A surface without vertices gets none stored (large,
   // and most would be dropped): each is made for its tests, and the seeds' again below.
+  // The two tests of an edge are one: plane d at the vertex of (a, b, c) and plane c at
+  // that of (b, a, d) are both the sign of det(r_a, r_b, r_c, r_d) for the rows
+  // r = (n, -d) (the vertex of three planes is their rows' generalised cross product, W its
+  // last coordinate; the rows' order differs by two swaps), so the triangle with the
+  // larger index takes its neighbour's sign. Signs the candidate knows (s.far_side: the
+  // flips' tests of a polygon's diagonals, the repair's unchanged edges) are not tested.
   const bool stored = !s.vertex.empty();
   const bool can_repair = repaired && stored;
   std::atomic<bool> reflex = false;  // an edge to repair
   std::vector<signed char> far_side(3 * static_cast<std::size_t>(nt));
+  // The slot of triangle t's edge k in the triangle across it, where that one runs back
+  // along it and has t across; -1 otherwise (then each side is tested on its own).
+  const auto twin = [&](int t, int k) {
+    const int u = s.across[t][k], a = s.corner[t][k], b = s.corner[t][k == 2 ? 0 : k + 1];
+    for (int j = 0; j < 3; ++j)
+      if (s.corner[u][j] == b && s.corner[u][j == 2 ? 0 : j + 1] == a)
+        return s.across[u][j] == t ? j : -1;
+    return -1;
+  };
+  const auto note = [&](int sd) {
+    if (sd <= 0) return;
+    if (can_repair)
+      reflex = true;
+    else
+      ok = false;
+  };
+  constexpr signed char kLater = 3;  // taken from the neighbour's test afterwards
   parallel_chunks(nt, 256, [&](int begin, int end) {
     RoundingGuard guard;
     HVertex local;
     for (int t = begin; t < end && ok; ++t) {
-      if (!s.far_side.empty() && s.far_side[3 * t] != 2 && s.far_side[3 * t + 1] != 2 &&
-          s.far_side[3 * t + 2] != 2) {
-        // (Its vertex is stored: a triangle the repair left.)
-        for (int k = 0; k < 3; ++k)
-          if ((far_side[3 * t + k] = s.far_side[3 * t + k]) > 0) ok = false;
-        continue;
+      int untested = 0;
+      for (int k = 0; k < 3; ++k) {
+        signed char& f = far_side[3 * t + k];
+        f = s.far_side.empty() ? 2 : s.far_side[3 * t + k];
+        if (f != 2) {
+          note(f);
+        } else if (s.across[t][k] < t && twin(t, k) >= 0) {
+          f = kLater;
+        } else {
+          ++untested;
+        }
       }
+      // (A stored vertex is made for every triangle: the repair and the steps below use it.)
+      if (untested == 0 && (!stored || s.has_vertex[t])) continue;
       HVertex& v = stored ? s.vertex[t] : local;
       if (!stored) {
         // A polygon's triangles come in a row and, in a closing, share one known point: the
@@ -1164,6 +1195,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
         v = independent_vertex_of(planes, s.corner[t], known);
       }
       for (int k = 0; k < 3; ++k) {
+        if (far_side[3 * t + k] != 2) continue;
         const auto& cn = s.corner[s.across[t][k]];
         const int a = s.corner[t][k], b = s.corner[t][(k + 1) % 3];
         int far = -1;
@@ -1172,15 +1204,20 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
         const int sd = far < 0                        ? 1
                        : known_through(known, far, v) ? 0
                                                       : side(planes, precise, far, v);
-        if (sd > 0) {
-          if (can_repair)
-            reflex = true;
-          else
-            ok = false;
-        }
+        note(sd);
         far_side[3 * t + k] = static_cast<signed char>(sd);
       }
     }
+  });
+  if (!ok) return std::nullopt;
+  parallel_chunks(nt, 1024, [&](int begin, int end) {
+    for (int t = begin; t < end; ++t)
+      for (int k = 0; k < 3; ++k)
+        if (far_side[3 * t + k] == kLater) {
+          const int u = s.across[t][k];
+          far_side[3 * t + k] = far_side[3 * u + twin(t, k)];
+          note(far_side[3 * t + k]);
+        }
   });
   if (!ok) return std::nullopt;
   if (reflex) {
@@ -2023,6 +2060,8 @@ struct PolygonScratch {
   std::vector<std::pair<int, int>> pending;  // diagonals to test
   std::vector<V3<Interval>> cross;           // n_i x n_j of positions i, j (k i + j)
   std::vector<char> has_cross;
+  std::vector<signed char> diagonal_side;  // of diagonal i, j (k i + j, i < j), or 2
+  std::vector<int> owner;  // 3 t + slot of the triangle t holding edge i -> j (k i + j), or -1
 };
 
 /// Flips per corner after which a polygon's triangulation gives up: Lawson's flips may
@@ -2041,13 +2080,26 @@ constexpr int kFlipsPerCorner = 4;
 /// the check), or the polygon would split and `split` is false (ExpectedVertices::split).
 /// When it splits the polygon, each final triangle's vertex is in out_vertex (out_has set;
 /// it is the flips' scratch space on the way).
+/// out_far (3 per triangle) gets the check's far-plane sign of each diagonal's edge (see
+/// build_verified; 2 for the polygon's own edges): the last test of each diagonal, made
+/// with its final triangles, or for a diagonal a flip made, -1 (the flipped test's four
+/// planes in an odd order: the opposite sign, and it was positive); 0 for planes through
+/// one known point (four planes through a point).
 /// Needs a RoundingGuard.
 bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& precise,
-                         const KnownPoints& known, const int* p, int k, bool split, std::array<int, 3>* out, HVertex* out_vertex,
-                         char* out_has, PolygonScratch& scratch) {
+                         const KnownPoints& known, const int* p, int k, bool split,
+                         std::array<int, 3>* out, HVertex* out_vertex, char* out_has,
+                         signed char* out_far, PolygonScratch& scratch) {
   // Planes through one known point (facets of A moved by one vertex of B): one vertex.
   if (k == 3 || common_point(known, p, k) >= 0) {
-    for (int i = 1; i + 1 < k; ++i) out[i - 1] = {p[0], p[i], p[i + 1]};
+    for (int i = 1; i + 1 < k; ++i) {
+      out[i - 1] = {p[0], p[i], p[i + 1]};
+      // The diagonals: (p[0], p[i]) and (p[i + 1], p[0]) where they are not polygon edges.
+      signed char* f = out_far + 3 * (i - 1);
+      f[0] = i > 1 ? 0 : 2;
+      f[1] = 2;
+      f[2] = i + 2 < k ? 0 : 2;
+    }
     return true;
   }
   if (!split) return false;
@@ -2057,13 +2109,27 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
   auto& pending = scratch.pending;
   triangle.clear();
   pending.clear();
+  auto& owner = scratch.owner;
+  owner.assign(static_cast<std::size_t>(k) * k, -1);
+  // Triangle t's corners and the owner of each of its edges.
+  const auto set_triangle = [&](int t, int x, int y, int z) {
+    triangle[t] = {x, y, z};
+    owner[x * k + y] = 3 * t;
+    owner[y * k + z] = 3 * t + 1;
+    owner[z * k + x] = 3 * t + 2;
+  };
   for (int i = 1; i + 1 < k; ++i) {
-    triangle.push_back({0, i, i + 1});
+    triangle.emplace_back();
+    set_triangle(i - 1, 0, i, i + 1);
     if (i > 1) pending.emplace_back(0, i);
   }
   ready.assign(triangle.size(), 0);
   scratch.cross.resize(static_cast<std::size_t>(k) * k);
   scratch.has_cross.assign(static_cast<std::size_t>(k) * k, 0);
+  scratch.diagonal_side.assign(static_cast<std::size_t>(k) * k, 2);
+  const auto diagonal_side = [&](int a, int c) -> signed char& {
+    return scratch.diagonal_side[a < c ? a * k + c : c * k + a];
+  };
   // The cross product of the interval normals of positions i and j, computed once for
   // both orders (n_j x n_i is its exact negation: the same intervals as computed afresh).
   const auto cross_of = [&](int i, int j) -> const V3<Interval>& {
@@ -2078,7 +2144,8 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
     scratch.has_cross[i * k + j] = 1;
     return c;
   };
-  // Triangle t's vertex, as vertex_of(planes, abc, known) computes it.
+  // Triangle t's vertex, as vertex_of(planes, abc, known) computes it but for xi, which
+  // the flips' tests do not use: made for the final triangles only.
   const auto compute_vertex = [&](int t) {
     ready[t] = 1;
     const auto [i, j, l] = triangle[t];
@@ -2090,8 +2157,7 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
     const Plane &a = planes[p[i]], &b = planes[p[j]], &c = planes[p[l]];
     meet_of_crosses(a.ni, a.di, b.di, c.di, cross_of(j, l), cross_of(l, i), cross_of(i, j), v.Xi,
                     v.Wi);
-    v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
-    take_known(known, v);
+    take_known(known, v);  // (a known point's xi is set)
   };
   // Triangle t's vertex (computed when first tested); false when t is not positively
   // oriented.
@@ -2103,15 +2169,17 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
   };
   // The triangle holding the directed edge a -> c and that edge's slot in it, or -1.
   const auto find = [&](int a, int c, int& slot) {
-    for (int t = 0; t < static_cast<int>(triangle.size()); ++t)
-      for (slot = 0; slot < 3; ++slot)
-        if (triangle[t][slot] == a && triangle[t][(slot + 1) % 3] == c) return t;
-    return -1;
+    const int o = owner[a * k + c];
+    slot = o % 3;
+    return o < 0 ? -1 : o / 3;
   };
   const auto side_of = [&](int plane, HVertex& v) {
     return known_through(known, p[plane], v) ? 0 : side(planes, precise, p[plane], v);
   };
-  const auto diagonal = [&](int a, int c) { return (c - a + k) % k != 1 && (a - c + k) % k != 1; };
+  const auto diagonal = [&](int a, int c) {  // not a side of the polygon
+    const int gap = a > c ? a - c : c - a;
+    return gap != 1 && gap != k - 1;
+  };
   for (int flips = 0; !pending.empty();) {
     const auto [a, c] = pending.back();
     pending.pop_back();
@@ -2119,20 +2187,43 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
     const int t = find(a, c, i), u = find(c, a, j);
     if (t < 0 || u < 0) continue;  // flipped away meanwhile
     const int b = triangle[t][(i + 2) % 3], d = triangle[u][(j + 2) % 3];
-    if (!make_vertex(t)) return false;
-    if (side_of(d, vertex[t]) <= 0) continue;
+    // Plane d at t's vertex, or the same sign from the other side when only u's is made:
+    // plane b at the vertex of u = (c, a, d) (see build_verified's far-plane tests).
+    int sd;
+    if (!ready[t] && ready[u]) {
+      sd = side_of(b, vertex[u]);
+    } else {
+      if (!make_vertex(t)) return false;
+      sd = side_of(d, vertex[t]);
+    }
+    if (sd <= 0) {
+      diagonal_side(a, c) = static_cast<signed char>(sd);
+      continue;
+    }
     if (++flips > kFlipsPerCorner * k) return false;
-    triangle[t] = {a, d, b};
-    triangle[u] = {d, c, b};
+    owner[a * k + c] = owner[c * k + a] = -1;
+    set_triangle(t, a, d, b);
+    set_triangle(u, d, c, b);
     ready[t] = ready[u] = 0;
+    diagonal_side(b, d) = -1;
+    // The quadrilateral's sides have a new triangle each: tested again where diagonals.
     for (const auto& e : {std::pair(a, d), std::pair(d, c), std::pair(c, b), std::pair(b, a)})
-      if (diagonal(e.first, e.second)) pending.push_back(e);
+      if (diagonal(e.first, e.second)) {
+        diagonal_side(e.first, e.second) = 2;
+        pending.push_back(e);
+      }
   }
   // Every final triangle's vertex, for the check (the untested ones cheaply, from the
   // cross products at hand; their orientation is left to the check).
   for (std::size_t t = 0; t < triangle.size(); ++t) {
     out[t] = {p[triangle[t][0]], p[triangle[t][1]], p[triangle[t][2]]};
+    for (int m = 0; m < 3; ++m) {
+      const int x = triangle[t][m], y = triangle[t][m == 2 ? 0 : m + 1];
+      out_far[3 * t + m] = diagonal(x, y) ? diagonal_side(x, y) : 2;
+    }
     if (!ready[t]) compute_vertex(static_cast<int>(t));
+    HVertex& v = vertex[t];
+    if (v.known < 0) v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
     out_has[t] = 1;
   }
   return true;
@@ -2158,12 +2249,14 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const PrecisePlan
     s.vertex.resize(nt);
     s.has_vertex.assign(nt, 0);
   }
+  s.far_side.resize(3 * static_cast<std::size_t>(nt));
   std::atomic<bool> ok = true;
   const auto triangulate = [&](int v, PolygonScratch& scratch) {
     if (!triangulate_polygon(planes, precise, known, &expected.facets[expected.begin[v]],
                              expected.begin[v + 1] - expected.begin[v], expected.split,
                              &s.corner[first[v]], expected.split ? &s.vertex[first[v]] : nullptr,
-                             expected.split ? &s.has_vertex[first[v]] : nullptr, scratch))
+                             expected.split ? &s.has_vertex[first[v]] : nullptr,
+                             &s.far_side[3 * static_cast<std::size_t>(first[v])], scratch))
       ok = false;
   };
   parallel_chunks(ok ? nv : 0, 64, [&](int begin, int end) {
