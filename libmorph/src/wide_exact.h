@@ -305,6 +305,41 @@ inline void set_exact(const V3<Int<N>>& v, int exp, V3<ExactN>& out) {
   set_exact(v.z, exp, out.z);
 }
 
+/// 2^exp a in double-double (round-to-nearest): hi the nearest double to the leading 126
+/// bits of |a| (all of them below 2^126), lo the exact rest of those bits rounded to
+/// nearest. Within 2^-103 of |hi|: lo errs by 2^-53 |lo| <= 2^-106 |hi|, the bits dropped
+/// below the leading 126 by under 2^-125 |a|. Both scale exactly: false when 2^exp |a|
+/// could pass 2^600 or the scale fall below 2^-900 (a non-zero lo is an integer, at least
+/// that scale), and `out` is then unchanged. As HalfSpace::offset_dd and normal_dd need.
+template <int N>
+inline bool to_dd(const Int<N>& a, int exp, DD& out) {
+  const bool negative = is_negative(a);
+  const Int<N> x = negative ? negated(a) : a;
+  int top = N - 1;
+  while (top >= 0 && x.w[top] == 0) --top;
+  if (top < 0) {
+    out = {0, 0};
+    return true;
+  }
+  // |a| = T 2^shift + rest, T below 2^126 (its conversions to i128 and back exact).
+  const int bits = 64 * top + 64 - __builtin_clzll(x.w[top]);
+  const int shift = std::max(bits - 126, 0);
+  const int e = exp + shift;
+  if (e < -900 || e > 600 - 126) return false;
+  const auto word = [&](int i) { return i < N ? x.w[i] : std::uint64_t{0}; };
+  const int q = shift >> 6, r = shift & 63;
+  const std::uint64_t low = r == 0 ? word(q) : (word(q) >> r) | (word(q + 1) << (64 - r));
+  const std::uint64_t high = r == 0 ? word(q + 1) : (word(q + 1) >> r) | (word(q + 2) << (64 - r));
+  const i128 t = static_cast<i128>((static_cast<u128>(high) << 64) | low);
+  const double hi = static_cast<double>(t);
+  const double lo = static_cast<double>(t - static_cast<i128>(hi));
+  const std::uint64_t scale_bits = static_cast<std::uint64_t>(1023 + e) << 52;
+  double scale;
+  std::memcpy(&scale, &scale_bits, sizeof scale);
+  out = negative ? DD{-hi * scale, -lo * scale} : DD{hi * scale, lo * scale};
+  return true;
+}
+
 /// The normal (x1 - x0) x (y1 - y0) of doubles in a frame (frame.ok), exact, in 128 bits
 /// per component for a small frame, else 256; its dot products with the frame's points.
 class Normal {
@@ -350,16 +385,24 @@ class Normal {
     }
     return true;
   }
-  /// Sets `out` (default-constructed: zero) to 2^doubling <n, u - v>, or <n, u> when v is null.
-  void set_dot(int doubling, const V3<double>& u, const V3<double>* v, ExactN& out) const {
+  /// Sets `out` (default-constructed: zero) to 2^doubling <n, u - v>, or <n, u> when v is null;
+  /// and `dd`, when not null, to its double-double copy from the same words (to_dd: within
+  /// 2^-103 of |hi|), returning whether to_dd made one (else `dd` is unchanged).
+  bool set_dot(int doubling, const V3<double>& u, const V3<double>* v, ExactN& out,
+               DD* dd = nullptr) const {
     const int exp = 3 * frame_.unit + doubling;
+    const auto set = [&](const auto& value) {
+      set_exact(value, exp, out);
+      if (!dd) return false;
+      CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+      return to_dd(value, exp, *dd);
+    };
     if (frame_.small) {
       const V3<std::int64_t> d = v ? small(u) - small(*v) : small(u);
-      set_exact(dot(small_, d), exp, out);
-    } else {
-      const V3<i128> d = v ? large(u) - large(*v) : large(u);
-      set_exact(dot(large_, d), exp, out);
+      return set(dot(small_, d));
     }
+    const V3<i128> d = v ? large(u) - large(*v) : large(u);
+    return set(dot(large_, d));
   }
 
  private:
