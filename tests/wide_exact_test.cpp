@@ -208,6 +208,21 @@ TEST_CASE("fixed-point words to double-double: within the bound, or refused out 
   }
   CHECK(converted > 5000);
   CHECK(refused > 1000);
+  // magnitude_dd at binade boundaries (lo below a power of two: the smaller gap), at and
+  // next to ties of the top 53 bits, across the 42-bit pieces.
+  const fixed::u128 one = 1;
+  for (int k = 0; k < 126; ++k) {
+    for (const fixed::u128 t :
+         {one << k, (one << k) - 1, (one << k) + 1, (one << k) | (one << (k > 53 ? k - 53 : 0)),
+          ((one << k) | (one << (k > 53 ? k - 53 : 0))) + 1, (one << k) | (one << (k / 2)) | 1,
+          (one << 126) - 1 - (one << k)}) {
+      if (t >= (one << 126)) continue;
+      const DD d = fixed::magnitude_dd(t);
+      check_dd(d, words_value(fixed::Int<2>{{static_cast<std::uint64_t>(t),
+                                             static_cast<std::uint64_t>(t >> 64)}},
+                              0));
+    }
+  }
   // Exactly at a tie of the leading 126 bits, and zero.
   fixed::Int<3> tie{{0, (std::uint64_t{1} << 61) | 1, 1}};
   DD out;
