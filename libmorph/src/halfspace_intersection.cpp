@@ -77,17 +77,10 @@ struct Plane {
   const HalfSpace* source = nullptr;
 };
 
-/// The interval of a component in double-double within 2^-101 of its |hi| (as
-/// HalfSpace::normal_dd; needs a RoundingGuard: the bound rounds up).
-Interval dd_interval(const DD& c) {
-  const double e = 0x1p-101 * std::abs(c.hi);
-  return Interval(c.hi) + Interval(c.lo) + Interval(-e, e);
-}
-
-/// The enclosure of an offset's double-double copy (HalfSpace::offset_dd: the value lies
+/// The enclosure of a double-double copy (HalfSpace::normal_dd, offset_dd: the value lies
 /// within half the gap to a neighbour of hi, plus 2^-101 |hi|, of hi): hi's two neighbours,
 /// from its bit pattern. No rounded operation, so the same in any rounding mode (also under
-/// valgrind, which keeps round-to-nearest).
+/// valgrind, which keeps round-to-nearest: hi + lo + [-e, e] rounded would collapse there).
 Interval neighbours_interval(const DD& c) {
   if (c.hi == 0) return Interval(0);  // then the value is zero
   std::uint64_t bits;
@@ -113,12 +106,12 @@ std::vector<Plane> planes_of(const std::vector<HalfSpace>& hs) {
       if (q == 1 && hs[i].has_normal_dd) {
         // The normal's enclosure from its double-double copy (cheaper than from Mpzf).
         const auto& c = hs[i].normal_dd;
-        p.ni = {dd_interval(c[0]), dd_interval(c[1]), dd_interval(c[2])};
+        p.ni = {neighbours_interval(c[0]), neighbours_interval(c[1]), neighbours_interval(c[2])};
       } else {
         p.ni = to_interval_n(p.n);
       }
-      p.di = q == 1 && hs[i].has_offset_dd ? neighbours_interval(hs[i].offset_dd)
-                                           : to_interval_n(p.d);
+      p.di =
+          q == 1 && hs[i].has_offset_dd ? neighbours_interval(hs[i].offset_dd) : to_interval_n(p.d);
     }
   });
   return planes;
