@@ -822,27 +822,38 @@ TEST_CASE("halfspace_intersection: the precise stage rounds vertices as the exac
           const V3<double> n0 = normals[a], n1 = normals[a + 1];
           const V3<double> n2 =
               tilt == 0 ? normals[a + 2] : V3<double>{n0.x + tilt, n0.y - tilt, n0.z + tilt / 3};
-          const PreciseProbe probe = probe_precise(three_through(n0, n1, n2, p, scale));
-          const ExactN* c[3] = {&p.x, &p.y, &p.z};
-          const double got[3] = {probe.rounded.x, probe.rounded.y, probe.rounded.z};
-          for (int i = 0; i < 3; ++i) {
-            ++total;
-            // Within 2^-52 ulp of a tie (2^-104 relative): always inside the enclosure.
-            if (k == 1 || k >= 52) CHECK(!probe.decided[i]);
-            if (!probe.decided[i]) continue;
-            ++decided;
-            CHECK(same_double(got[i], rounded_exactly(*c[i])));
-          }
-          // Far from a tie relative to the vertex's size (its largest coordinate): the
-          // error bound is about 2^-95 of that for these well-conditioned normals.
-          const double largest = std::max(
-              {std::abs(p.x.to_double()), std::abs(p.y.to_double()), std::abs(p.z.to_double())});
-          for (int i = 0; i < 3; ++i) {
-            const double x = c[i]->to_double(),
-                         ulp = std::nextafter(std::abs(x), HUGE_VAL) - std::abs(x);
-            const double distance = k == 0 ? ulp / 2 : std::ldexp(ulp, -k);
-            if (tilt == 0 && k != 1 && distance >= 0x1p-80 * largest)
-              far_from_ties++, far_decided += probe.decided[i];
+          for (const bool given : {false, true}) {
+            // given: each offset also as a double-double copy (HalfSpace::offset_dd, as an
+            // erosion makes it), which the filters and the precise stage then take.
+            std::vector<HalfSpace> hs = three_through(n0, n1, n2, p, scale);
+            for (HalfSpace& h : hs) {
+              double error;
+              const DD d = to_dd(h.offset, error);
+              h.has_offset_dd = given && error <= 0x1p-102 * std::abs(d.hi);
+              if (h.has_offset_dd) h.offset_dd = d;
+            }
+            const PreciseProbe probe = probe_precise(hs);
+            const ExactN* c[3] = {&p.x, &p.y, &p.z};
+            const double got[3] = {probe.rounded.x, probe.rounded.y, probe.rounded.z};
+            for (int i = 0; i < 3; ++i) {
+              ++total;
+              // Within 2^-52 ulp of a tie (2^-104 relative): always inside the enclosure.
+              if (k == 1 || k >= 52) CHECK(!probe.decided[i]);
+              if (!probe.decided[i]) continue;
+              ++decided;
+              CHECK(same_double(got[i], rounded_exactly(*c[i])));
+            }
+            // Far from a tie relative to the vertex's size (its largest coordinate): the
+            // error bound is about 2^-95 of that for these well-conditioned normals.
+            const double largest = std::max(
+                {std::abs(p.x.to_double()), std::abs(p.y.to_double()), std::abs(p.z.to_double())});
+            for (int i = 0; i < 3; ++i) {
+              const double x = c[i]->to_double(),
+                           ulp = std::nextafter(std::abs(x), HUGE_VAL) - std::abs(x);
+              const double distance = k == 0 ? ulp / 2 : std::ldexp(ulp, -k);
+              if (tilt == 0 && k != 1 && distance >= 0x1p-80 * largest)
+                far_from_ties++, far_decided += probe.decided[i];
+            }
           }
         }
       }

@@ -21,6 +21,31 @@ struct Case {
   V3<double> p, q, r, b;
 };
 
+/// A double-double copy within 2^-103 of |hi| (HalfSpace::offset_dd asks 2^-101) of the
+/// exact value, |lo| at most half the gap to hi's neighbour on lo's side.
+void check_dd(const DD& dd, const ExactN& exact) {
+  const ExactN error = ExactN(dd.hi) + ExactN(dd.lo) - exact;
+  CHECK(CGAL::abs(error) * ExactN(0x1p103) <= CGAL::abs(ExactN(dd.hi)));
+  const double side = dd.lo < 0 ? -std::numeric_limits<double>::infinity()
+                                : std::numeric_limits<double>::infinity();
+  const double half_gap = 0.5 * std::abs(std::nextafter(dd.hi, side) - dd.hi);
+  CHECK(std::abs(dd.lo) <= half_gap);
+  CHECK((CGAL::sign(exact) == 0) == (dd.hi == 0));
+}
+
+/// The exact value 2^exp a of fixed-point words, from 32-bit pieces (exact doubles).
+template <int N>
+ExactN words_value(fixed::Int<N> a, int exp) {
+  const bool negative = fixed::is_negative(a);
+  if (negative) a = fixed::negated(a);
+  ExactN v(0);
+  for (int i = 0; i < N; ++i) {
+    v = v + ExactN(std::ldexp(static_cast<double>(a.w[i] >> 32), 64 * i + 32 + exp)) +
+        ExactN(std::ldexp(static_cast<double>(a.w[i] & 0xffffffff), 64 * i + exp));
+  }
+  return negative ? ExactN(0) - v : v;
+}
+
 /// Checks fixed::Normal against Mpzf on the triangle (p, q, r) and the point b; whether the
 /// frame was small, large, or not ok (0, 1, 2).
 int check(const Case& c) {
@@ -54,7 +79,15 @@ int check(const Case& c) {
   }
   const ExactN offset = dot(n, exact_difference(p, b));
   ExactN fo;
-  f.set_dot(0, p, &b, fo);
+  DD odd{7, 0};
+  if (f.set_dot(0, p, &b, fo, &odd)) {
+    check_dd(odd, offset);
+  } else {
+    CHECK(odd.hi == 7);  // unchanged
+    // to_dd refuses only a value from 2^474 or a scale below 2^-900.
+    const bool in_range = 3 * frame.unit >= -900 && std::abs(offset.to_double()) < 0x1p470;
+    CHECK_FALSE(in_range);
+  }
   CHECK(fo == offset);
   CHECK(f.sign_dot(p, b) == CGAL::sign(offset));
   CHECK(f.sign_dot(b, q) == CGAL::sign(dot(n, exact_difference(b, q))));
@@ -132,4 +165,70 @@ TEST_CASE("fixed-point frames refuse what they cannot hold") {
   // All zero: a zero normal and offset.
   Case z{{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
   CHECK(check(z) == 0);
+}
+
+TEST_CASE("fixed-point words to double-double: within the bound, or refused out of range") {
+  // Integers of every width up to 6 words, with runs of ones and zeros (ties and carries
+  // in the rounding of the leading 126 bits), either sign, scaled by 2^-1000 .. 2^600.
+  std::mt19937_64 rng(1124);
+  const auto word = [&] {
+    switch (rng() % 5) {
+      case 0:
+        return std::uint64_t{0};
+      case 1:
+        return ~std::uint64_t{0};
+      case 2:
+        return std::uint64_t{1} << (rng() % 64);
+      case 3:
+        return (std::uint64_t{1} << 63) | 1;
+      default:
+        return static_cast<std::uint64_t>(rng());
+    }
+  };
+  int converted = 0, refused = 0;
+  for (int it = 0; it < 20000; ++it) {
+    fixed::Int<6> a{};
+    const int used = 1 + static_cast<int>(rng() % 6);
+    for (int i = 0; i < used; ++i) a.w[i] = word();
+    if (rng() % 2) a = fixed::negated(a);
+    const int exp = static_cast<int>(rng() % 1600) - 1000;
+    DD out{7, 7};
+    if (fixed::to_dd(a, exp, out)) {
+      ++converted;
+      check_dd(out, words_value(a, exp));
+    } else {
+      ++refused;
+      CHECK(out.hi == 7);
+      CHECK(out.lo == 7);
+    }
+    // The same value in three words, when it fits (the small frame's offsets).
+    fixed::Int<3> b{{a.w[0], a.w[1], a.w[2]}};
+    if (words_value(b, 0) == words_value(a, 0) && fixed::to_dd(b, exp, out))
+      check_dd(out, words_value(a, exp));
+  }
+  CHECK(converted > 5000);
+  CHECK(refused > 1000);
+  // magnitude_dd at binade boundaries (lo below a power of two: the smaller gap), at and
+  // next to ties of the top 53 bits, across the 42-bit pieces.
+  const fixed::u128 one = 1;
+  for (int k = 0; k < 126; ++k) {
+    for (const fixed::u128 t :
+         {one << k, (one << k) - 1, (one << k) + 1, (one << k) | (one << (k > 53 ? k - 53 : 0)),
+          ((one << k) | (one << (k > 53 ? k - 53 : 0))) + 1, (one << k) | (one << (k / 2)) | 1,
+          (one << 126) - 1 - (one << k)}) {
+      if (t >= (one << 126)) continue;
+      const DD d = fixed::magnitude_dd(t);
+      check_dd(d, words_value(fixed::Int<2>{{static_cast<std::uint64_t>(t),
+                                             static_cast<std::uint64_t>(t >> 64)}},
+                              0));
+    }
+  }
+  // Exactly at a tie of the leading 126 bits, and zero.
+  fixed::Int<3> tie{{0, (std::uint64_t{1} << 61) | 1, 1}};
+  DD out;
+  REQUIRE(fixed::to_dd(tie, -200, out));
+  check_dd(out, words_value(tie, -200));
+  REQUIRE(fixed::to_dd(fixed::Int<3>{{0, 0, 0}}, 0, out));
+  CHECK(out.hi == 0);
+  CHECK(out.lo == 0);
 }

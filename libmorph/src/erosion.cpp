@@ -221,13 +221,13 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
               &r = A.points[A.corner(f, 2)], &pb = B.points[b];
         on[0] = on[1] = on[2] = 1;
         // In fixed point (wide_exact.h) when the doubles allow, else in Mpzf: the same values.
-        // The normal's double-double copy from its exact words, or from the doubles (cheaper
-        // than from the exact value).
+        // The normal's and the offset's double-double copies from their exact words (the
+        // normal's from the doubles otherwise): cheaper than from the exact values.
         const fixed::Frame frame{p.x, p.y, p.z, q.x, q.y, q.z, r.x, r.y, r.z, pb.x, pb.y, pb.z};
         if (frame.ok) {
           const fixed::Normal n(frame, p, q, p, r);
           n.set_normal(0, h.normal);  // hs's are new: zero
-          n.set_dot(0, p, &pb, h.offset);
+          h.has_offset_dd = n.set_dot(0, p, &pb, h.offset, &h.offset_dd);
           h.has_normal_dd = n.normal_dd(0, h.normal_dd);
           if (!h.has_normal_dd) set_normal_dd(h, p, q, r);
         } else {
@@ -264,7 +264,7 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
           const fixed::Normal n(frame, p0, p2, p1, p3);
           const int top = set_top(n.sign_dot(p1, p0));
           n.set_normal(0, h.normal);  // hs's are new: zero
-          n.set_dot(0, top == 1 ? p1 : p0, &pb, h.offset);
+          h.has_offset_dd = n.set_dot(0, top == 1 ? p1 : p0, &pb, h.offset, &h.offset_dd);
           h.has_normal_dd = n.normal_dd(0, h.normal_dd);
           add_others_on_plane(h.normal);
           continue;

@@ -73,14 +73,23 @@ struct Plane {
   ExactN d;
   V3<Interval> ni;
   Interval di;
-  const HalfSpace* source = nullptr;  // its normal's double-double copy, when it has one
+  // Its normal's or offset's double-double copy, when it has one (denominator 1).
+  const HalfSpace* source = nullptr;
 };
 
-/// The interval of a component in double-double within 2^-101 of its |hi| (as
-/// HalfSpace::normal_dd; needs a RoundingGuard: the bound rounds up).
-Interval dd_interval(const DD& c) {
-  const double e = 0x1p-101 * std::abs(c.hi);
-  return Interval(c.hi) + Interval(c.lo) + Interval(-e, e);
+/// The enclosure of a double-double copy (HalfSpace::normal_dd, offset_dd: the value lies
+/// within half the gap to a neighbour of hi, plus 2^-101 |hi|, of hi): hi's two neighbours,
+/// from its bit pattern. No rounded operation, so the same in any rounding mode (also under
+/// valgrind, which keeps round-to-nearest: hi + lo + [-e, e] rounded would collapse there).
+Interval neighbours_interval(const DD& c) {
+  if (c.hi == 0) return Interval(0);  // then the value is zero
+  std::uint64_t bits;
+  std::memcpy(&bits, &c.hi, sizeof bits);
+  double away, toward;  // |away| > |hi| > |toward|, same signs (toward may be zero)
+  const std::uint64_t up = bits + 1, down = bits - 1;
+  std::memcpy(&away, &up, sizeof away);
+  std::memcpy(&toward, &down, sizeof toward);
+  return c.hi > 0 ? Interval(toward, away) : Interval(away, toward);
 }
 
 std::vector<Plane> planes_of(const std::vector<HalfSpace>& hs) {
@@ -93,15 +102,16 @@ std::vector<Plane> planes_of(const std::vector<HalfSpace>& hs) {
       p.n = q == 1 ? hs[i].normal
                    : V3<ExactN>{hs[i].normal.x * q, hs[i].normal.y * q, hs[i].normal.z * q};
       p.d = hs[i].offset;
+      if (q == 1 && (hs[i].has_normal_dd || hs[i].has_offset_dd)) p.source = &hs[i];
       if (q == 1 && hs[i].has_normal_dd) {
         // The normal's enclosure from its double-double copy (cheaper than from Mpzf).
-        p.source = &hs[i];
         const auto& c = hs[i].normal_dd;
-        p.ni = {dd_interval(c[0]), dd_interval(c[1]), dd_interval(c[2])};
+        p.ni = {neighbours_interval(c[0]), neighbours_interval(c[1]), neighbours_interval(c[2])};
       } else {
         p.ni = to_interval_n(p.n);
       }
-      p.di = to_interval_n(p.d);
+      p.di =
+          q == 1 && hs[i].has_offset_dd ? neighbours_interval(hs[i].offset_dd) : to_interval_n(p.d);
     }
   });
   return planes;
@@ -332,14 +342,16 @@ constexpr double kPlaneRelative = 0x1p-100;
 /// [1, 2); false when a value is beyond 2^400 or a non-zero one below 2^-900 after that
 /// (round-to-nearest).
 /// `given`, when not null, holds c[0] .. c[2] already in double-double, each within
-/// kPlaneRelative / 2 of its |hi| (HalfSpace::normal_dd).
+/// kPlaneRelative / 2 of its |hi| (HalfSpace::normal_dd); `given_last` c[3] alike
+/// (HalfSpace::offset_dd).
 bool precise_scaled(const std::array<const ExactN*, 4>& c, int lead_begin, int lead_end,
-                    std::array<DD, 4>& out, const std::array<DD, 3>* given = nullptr) {
+                    std::array<DD, 4>& out, const std::array<DD, 3>* given = nullptr,
+                    const DD* given_last = nullptr) {
   std::array<DD, 4> v{};
   double largest = 0;
   for (int k = 0; k < 4; ++k) {
-    if (given && k < 3) {
-      v[k] = (*given)[k];
+    if ((given && k < 3) || (given_last && k == 3)) {
+      v[k] = k < 3 ? (*given)[k] : *given_last;
       if (k >= lead_begin && k < lead_end) largest = std::max(largest, std::abs(v[k].hi));
       continue;
     }
@@ -371,8 +383,10 @@ struct PrecisePlane {
 };
 PrecisePlane precise_plane(const Plane& plane) {
   PrecisePlane p;
+  const HalfSpace* h = plane.source;
   p.valid = precise_scaled({&plane.n.x, &plane.n.y, &plane.n.z, &plane.d}, 0, 3, p.c,
-                           plane.source ? &plane.source->normal_dd : nullptr);
+                           h && h->has_normal_dd ? &h->normal_dd : nullptr,
+                           h && h->has_offset_dd ? &h->offset_dd : nullptr);
   return p;
 }
 V3<DD> normal_dd(const PrecisePlane& p) { return {p.c[0], p.c[1], p.c[2]}; }

@@ -26,9 +26,16 @@ struct HalfSpace {
   int source = -1;                 // erosion: the facet of A (its label)
   int element = -1;                // erosion: the vertex of B that moved it inwards (its label)
   // Optional (set_normal_dd): the normal's components in double-double, each within 2^-101 of
-  // its |hi| (round-to-nearest), so the precise stage need not convert them from `normal`.
+  // its |hi|, |lo| at most half the gap to hi's neighbour on lo's side (round-to-nearest), so
+  // the precise stage and the filters' enclosures need not convert them from `normal`.
   std::array<DD, 3> normal_dd{};
   bool has_normal_dd = false;
+  // Optional: the offset in double-double within 2^-101 of |hi|, |lo| at most half the gap
+  // to hi's neighbour on lo's side (hi rounded to nearest), for a denominator 1: the
+  // filters' enclosure (hi's neighbours) and the precise stage's copy of the offset without
+  // converting the Mpzf (an erosion makes it from the same fixed-point words).
+  DD offset_dd{};
+  bool has_offset_dd = false;
 };
 
 /// Sets h.normal_dd from h.normal = (p1 - p0) x (p2 - p0) for a triangle of double points

@@ -305,6 +305,58 @@ inline void set_exact(const V3<Int<N>>& v, int exp, V3<ExactN>& out) {
   set_exact(v.z, exp, out.z);
 }
 
+/// t (below 2^126) in double-double (round-to-nearest), without a library conversion of a
+/// 128-bit integer: its three 42-bit pieces are exact doubles, the top two sum exactly
+/// (two_sum), so does the third into that sum's hi, and the two low parts are added in one
+/// rounded operation, within 2^-53 of their sum (at most an ulp of hi): within 2^-105 t. hi is
+/// then the double nearest hi + lo (quick_two_sum, exact), so |lo| is at most half the gap to
+/// hi's neighbour on lo's side. Every part is an integer: a non-zero lo is at least 1.
+inline DD magnitude_dd(u128 t) {
+  constexpr std::uint64_t kPiece = (std::uint64_t{1} << 42) - 1;
+  const double d2 = static_cast<double>(static_cast<std::int64_t>(t >> 84)) * 0x1p84;
+  const double d1 =
+      static_cast<double>(static_cast<std::int64_t>(static_cast<std::uint64_t>(t >> 42) & kPiece)) *
+      0x1p42;
+  const double d0 =
+      static_cast<double>(static_cast<std::int64_t>(static_cast<std::uint64_t>(t) & kPiece));
+  const DD a = two_sum(d2, d1);
+  const DD b = two_sum(a.hi, d0);
+  return quick_two_sum(b.hi, a.lo + b.lo);
+}
+
+/// 2^exp a in double-double (round-to-nearest): the leading 126 bits of |a| (all of them
+/// below 2^126) by magnitude_dd. Within 2^-103 of |hi|: magnitude_dd errs by 2^-105 of them,
+/// the bits dropped below the leading 126 by under 2^-125 |a|. Both scale exactly: false when 2^exp
+/// |a| could pass 2^600 or the scale fall below 2^-900 (a non-zero lo is an integer, at least that
+/// scale), and `out` is then unchanged. As HalfSpace::offset_dd and normal_dd need.
+template <int N>
+inline bool to_dd(const Int<N>& a, int exp, DD& out) {
+  const bool negative = is_negative(a);
+  const Int<N> x = negative ? negated(a) : a;
+  int top = N - 1;
+  while (top >= 0 && x.w[top] == 0) --top;
+  if (top < 0) {
+    out = {0, 0};
+    return true;
+  }
+  // |a| = T 2^shift + rest, T below 2^126 (its conversions to i128 and back exact).
+  const int bits = 64 * top + 64 - __builtin_clzll(x.w[top]);
+  const int shift = std::max(bits - 126, 0);
+  const int e = exp + shift;
+  if (e < -900 || e > 600 - 126) return false;
+  const auto word = [&](int i) { return i < N ? x.w[i] : std::uint64_t{0}; };
+  const int q = shift >> 6, r = shift & 63;
+  const std::uint64_t low = r == 0 ? word(q) : (word(q) >> r) | (word(q + 1) << (64 - r));
+  const std::uint64_t high = r == 0 ? word(q + 1) : (word(q + 1) >> r) | (word(q + 2) << (64 - r));
+  const DD d = magnitude_dd((static_cast<u128>(high) << 64) | low);
+  const double hi = d.hi, lo = d.lo;
+  const std::uint64_t scale_bits = static_cast<std::uint64_t>(1023 + e) << 52;
+  double scale;
+  std::memcpy(&scale, &scale_bits, sizeof scale);
+  out = negative ? DD{-hi * scale, -lo * scale} : DD{hi * scale, lo * scale};
+  return true;
+}
+
 /// The normal (x1 - x0) x (y1 - y0) of doubles in a frame (frame.ok), exact, in 128 bits
 /// per component for a small frame, else 256; its dot products with the frame's points.
 class Normal {
@@ -329,8 +381,8 @@ class Normal {
     else
       set_exact(large_, 2 * frame_.unit + doubling, normal);
   }
-  /// 2^doubling n in double-double, each component within 2^-104 of its |hi| (hi rounded to
-  /// nearest from the exact value, lo the rest rounded to nearest), as HalfSpace::normal_dd;
+  /// 2^doubling n in double-double, each component within 2^-104 of its |hi| (magnitude_dd:
+  /// hi the double nearest hi + lo), as HalfSpace::normal_dd;
   /// false for a large frame, or where the scaled words could leave 2^+-900 (then `out` is
   /// unchanged).
   bool normal_dd(int doubling, std::array<DD, 3>& out) const {
@@ -342,24 +394,32 @@ class Normal {
     CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
     const i128 c[3] = {small_.x, small_.y, small_.z};
     for (int k = 0; k < 3; ++k) {
-      // hi is an integer below 2^126, so c - hi is exact in 128 bits, and lo errs by at most
-      // 2^-53 |lo| <= 2^-106 |hi|; both scale exactly (non-zero ones are at least 2^e).
-      const double hi = static_cast<double>(c[k]);
-      const double lo = static_cast<double>(c[k] - static_cast<i128>(hi));
-      out[k] = {hi * scale, lo * scale};
+      // |c| below 2^126: magnitude_dd's hi and lo within 2^-105 |c| <= 2^-104 |hi|, integers,
+      // so both scale exactly (non-zero ones are at least 2^e).
+      bool negative;
+      const DD d = magnitude_dd(magnitude(c[k], negative));
+      out[k] = negative ? DD{-d.hi * scale, -d.lo * scale} : DD{d.hi * scale, d.lo * scale};
     }
     return true;
   }
-  /// Sets `out` (default-constructed: zero) to 2^doubling <n, u - v>, or <n, u> when v is null.
-  void set_dot(int doubling, const V3<double>& u, const V3<double>* v, ExactN& out) const {
+  /// Sets `out` (default-constructed: zero) to 2^doubling <n, u - v>, or <n, u> when v is null;
+  /// and `dd`, when not null, to its double-double copy from the same words (to_dd: within
+  /// 2^-103 of |hi|), returning whether to_dd made one (else `dd` is unchanged).
+  bool set_dot(int doubling, const V3<double>& u, const V3<double>* v, ExactN& out,
+               DD* dd = nullptr) const {
     const int exp = 3 * frame_.unit + doubling;
+    const auto set = [&](const auto& value) {
+      set_exact(value, exp, out);
+      if (!dd) return false;
+      CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+      return to_dd(value, exp, *dd);
+    };
     if (frame_.small) {
       const V3<std::int64_t> d = v ? small(u) - small(*v) : small(u);
-      set_exact(dot(small_, d), exp, out);
-    } else {
-      const V3<i128> d = v ? large(u) - large(*v) : large(u);
-      set_exact(dot(large_, d), exp, out);
+      return set(dot(small_, d));
     }
+    const V3<i128> d = v ? large(u) - large(*v) : large(u);
+    return set(dot(large_, d));
   }
 
  private:
