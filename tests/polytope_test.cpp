@@ -20,6 +20,14 @@
 
 namespace {
 
+/// f(mesh, file name) for every .off file of the samples.
+template <class F>
+void for_each_sample(const F& f) {
+  for (const auto& entry : std::filesystem::directory_iterator(MORPH_SAMPLES_DIR))
+    if (entry.path().extension() == ".off")
+      f(morph::read_mesh(entry.path().string()), entry.path().filename().string());
+}
+
 using morph::Mesh;
 using morph::Point;
 using morph::detail::FaceOrder;
@@ -162,13 +170,11 @@ void check_both_paths(const Mesh& mesh, const std::string& what) {
 }  // namespace
 
 TEST_CASE("polytope: the halfedge path and the cycle path agree on the samples") {
-  for (const auto& entry : std::filesystem::directory_iterator(MORPH_SAMPLES_DIR)) {
-    if (entry.path().extension() != ".off") continue;
-    const Mesh mesh = morph::read_mesh(entry.path().string());
-    check_both_paths(mesh, entry.path().filename().string());
+  for_each_sample([](const Mesh& mesh, const std::string& name) {
+    check_both_paths(mesh, name);
     check_both_paths(morph::test::transformed(mesh, morph::test::random_rotation(11)),
-                     entry.path().filename().string() + " rotated");
-  }
+                     name + " rotated");
+  });
 }
 
 TEST_CASE("polytope: generated operands, with and without coplanar neighbours") {
@@ -518,16 +524,13 @@ void check_unit_normals(const Mesh& mesh, const std::string& what) {
 }  // namespace
 
 TEST_CASE("polytope: unit normals lie within their error bounds of the exact directions") {
-  for (const auto& entry : std::filesystem::directory_iterator(MORPH_SAMPLES_DIR)) {
-    if (entry.path().extension() != ".off") continue;
-    const std::string name = entry.path().filename().string();
-    const Mesh mesh = morph::read_mesh(entry.path().string());
+  for_each_sample([&](const Mesh& mesh, const std::string& name) {
     check_unit_normals(mesh, name);
     check_unit_normals(morph::test::transformed(mesh, morph::test::random_rotation(5)),
                        name + " rotated");
     check_unit_normals(morph::test::scaled(mesh, 0x1p-200), name + " tiny");
     check_unit_normals(morph::test::scaled(mesh, 0x1p200), name + " huge");
-  }
+  });
   // Far from the origin the Newell sum cancels a lot: the bound must follow.
   const Mesh sphere = morph::read_mesh(std::string(MORPH_SAMPLES_DIR) + "/icosphere_1280.off");
   check_unit_normals(morph::test::translated(sphere, Point(1e6, -3e5, 7)), "far sphere");
@@ -562,10 +565,7 @@ void check_operand_normals(const Mesh& mesh, const std::string& what) {
 }  // namespace
 
 TEST_CASE("polytope: make_operand's unit normals from the check are compute_normals'") {
-  for (const auto& entry : std::filesystem::directory_iterator(MORPH_SAMPLES_DIR)) {
-    if (entry.path().extension() != ".off") continue;
-    const std::string name = entry.path().filename().string();
-    const Mesh mesh = morph::read_mesh(entry.path().string());
+  for_each_sample([&](const Mesh& mesh, const std::string& name) {
     check_operand_normals(mesh, name);
     check_operand_normals(morph::test::transformed(mesh, morph::test::random_rotation(7)),
                           name + " rotated");
@@ -574,7 +574,7 @@ TEST_CASE("polytope: make_operand's unit normals from the check are compute_norm
     check_operand_normals(morph::test::scaled(mesh, 0x1p-200), name + " tiny");
     check_operand_normals(morph::test::scaled(mesh, 0x1p200), name + " huge");
     check_operand_normals(morph::test::translated(mesh, Point(1e6, -3e5, 7)), name + " far");
-  }
+  });
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
     check_operand_normals(morph::test::random_sphere_polytope(300, seed),
                           "sphere " + std::to_string(seed));
