@@ -97,15 +97,15 @@ class Frame {
     }
     // Not ok for an infinity or a NaN (or an Mpzf that set_exact cannot make).
     if (largest >= 0x7ff0000000000000 || !exponent_shift_works()) return;
-    const int biased = static_cast<int>(largest >> 52);
-    // 2^high > |d| for every value.
-    const int high = biased != 0 ? biased - 1022 : -1074 + 64 - __builtin_clzll(largest);
     if (largest == 0) {  // all zero
       unit = 0;
       ok = small = true;
       scale_ = 1;
       return;
     }
+    const int biased = static_cast<int>(largest >> 52);
+    // 2^high > |d| for every value (largest is not zero here: clz is defined).
+    const int high = biased != 0 ? biased - 1022 : -1074 + 64 - __builtin_clzll(largest);
     unit = low;
     ok = high - low <= kInputBits;
     // Small also needs 2^-unit to be a double (the scaling below): units of doubles within
