@@ -243,15 +243,23 @@ std::vector<ArcPlane> arc_planes(const Polytope& P) {
   return planes;
 }
 
+namespace {
+
+/// The slot planes of v's region (its fan's consecutive facet normals), into `out`
+/// (P.fan_begin[v] onwards): slot_planes and SlotCache make the same doubles with it.
+void region_slot_planes(const Polytope& P, int v, ArcPlane* out) {
+  const int b = P.fan_begin[v], n = P.fan_begin[v + 1] - b;
+  const int* const fan = P.fan_face.data() + b;
+  for (int i = 0; i < n; ++i)
+    out[b + i] = cross_plane(P.unit_normals[fan[i]], P.unit_normals[fan[i + 1 == n ? 0 : i + 1]]);
+}
+
+}  // namespace
+
 std::vector<ArcPlane> slot_planes(const Polytope& P) {
   std::vector<ArcPlane> slots(P.fan_face.size());
   parallel_chunks(P.num_vertices(), 1024, [&](int begin, int end) {
-    for (int v = begin; v < end; ++v) {
-      const int b = P.fan_begin[v], n = P.fan_begin[v + 1] - b;
-      for (int i = 0; i < n; ++i)
-        slots[b + i] = cross_plane(P.unit_normals[P.fan_face[b + i]],
-                                   P.unit_normals[P.fan_face[b + (i + 1 == n ? 0 : i + 1)]]);
-    }
+    for (int v = begin; v < end; ++v) region_slot_planes(P, v, slots.data());
   });
   return slots;
 }
@@ -314,11 +322,7 @@ SlotCache::SlotCache(const Polytope& P)
       made_(P.num_vertices(), 0) {}
 
 void SlotCache::make(int v) {
-  const int b = P_->fan_begin[v], n = P_->fan_begin[v + 1] - b;
-  const int* const fan = P_->fan_face.data() + b;
-  for (int i = 0; i < n; ++i)
-    planes_[b + i] =
-        cross_plane(P_->unit_normals[fan[i]], P_->unit_normals[fan[i + 1 == n ? 0 : i + 1]]);
+  region_slot_planes(*P_, v, planes_.get());
   made_[v] = 1;
 }
 

@@ -865,6 +865,15 @@ std::optional<PreparedMesh> check_operand(const Mesh& mesh, std::string_view nam
 
 namespace {
 
+// A Geometry to be filled, on the caller's face cycles.
+Geometry on_cycles(const FaceCycleView& cycles) {
+  Geometry geometry;
+  geometry.cycles.begin = cycles.begin;
+  geometry.cycles.vertex = cycles.vertex;
+  geometry.cycles.across = cycles.across;
+  return geometry;
+}
+
 // geometry_passes() once `geometry` holds the face cycles.
 bool geometry_of_cycles_passes(const MeshView& m, Geometry& geometry, double planarity_tolerance) {
   if (nondegenerate(m, planarity_tolerance, geometry, true, true).verdict != Verdict::ok)
@@ -881,20 +890,14 @@ bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles, double plana
   // convex_polyhedron() after closed_manifold(), on the caller's cycles: the same checks on
   // the same values, without building the messages of a failure.
   const MeshView m(mesh, true);  // the caller's precondition
-  Geometry geometry;
-  geometry.cycles.begin = cycles.begin;
-  geometry.cycles.vertex = cycles.vertex;
-  geometry.cycles.across = cycles.across;
+  Geometry geometry = on_cycles(cycles);
   return geometry_of_cycles_passes(m, geometry, planarity_tolerance);
 }
 
 bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles, UnitNormal* unit_normals,
                      bool& complete) {
   const MeshView m(mesh, true);  // the caller's precondition
-  Geometry geometry;
-  geometry.cycles.begin = cycles.begin;
-  geometry.cycles.vertex = cycles.vertex;
-  geometry.cycles.across = cycles.across;
+  Geometry geometry = on_cycles(cycles);
   geometry.unit = unit_normals;
   const bool passes = geometry_of_cycles_passes(m, geometry, kPlanarityTolerance);
   complete = geometry.unit_complete;
