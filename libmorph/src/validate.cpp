@@ -395,18 +395,58 @@ bool has_equal_pair(int n, const Key& key) {
   return false;
 }
 
+// The plane of a triangle or a quadrilateral, computed ahead of its checks. nondegenerate()
+// works on these faces in three parts: triangle_plane() and quad_plane() read only the corners
+// (the Newell sum, the centroid and the fan volumes), plane_root() then takes the square root
+// and the division, and the heights come last, with triangle_passes() and quad_passes(). Each
+// of the first two parts runs over every such face in a loop whose iterations do not depend on
+// each other, short enough for several faces' chains of dependent operations (the second's a
+// square root then a division) to overlap.
+struct SmallPlane {
+  double cx, cy, cz;     // the centroid
+  double nx, ny, nz;     // the Newell sum; once plane_root() has passed the face, the unit normal
+  double first, second;  // six times the volumes of the fan's tetrahedra (a triangle has one)
+  double length2;        // (nx * nx + ny * ny) + nz * nz of the Newell sum
+  double magnitude;      // the sum of |a_k|_1 |a_(k+1)|_1 over the corners (for unit_normal())
+  int degree;            // 3 or 4
+  bool ok;               // false: a repeated vertex or position, or zero area (nothing else is set)
+};
+
+// The second part of a triangle's or quadrilateral's plane (see SmallPlane): its zero-area
+// test, unit normal (and the unit normal it leaves for the polytope).
+inline void plane_root(SmallPlane& q, double zero_area, detail::UnitNormal* unit,
+                       bool& unit_complete) {
+  if (!q.ok) return;
+  const double length = std::sqrt(q.length2);
+  if (!(length > zero_area)) {
+    q.ok = false;
+    return;
+  }
+  const double inverse = 1.0 / length;
+  if (unit)
+    unit_normal(*unit, q.nx, q.ny, q.nz, length, inverse, q.magnitude, q.degree, unit_complete);
+  q.nx *= inverse;
+  q.ny *= inverse;
+  q.nz *= inverse;
+}
+
+// height(plane, p) of a plane given by its centroid and unit normal: the same operations.
+struct PlaneHeight {
+  double cx, cy, cz, nx, ny, nz;
+  double operator()(const Point& p) const {
+    return (p[0] - cx) * nx + (p[1] - cy) * ny + (p[2] - cz) * nz;
+  }
+};
+
 // A triangle's share of nondegenerate(), the usual case: the same operations in the same
 // order as newell_plane(), height(), FanVolumes::add_face() and reflex_across(), unrolled
 // into one place (the general path's loops and calls cost more than its arithmetic), so
-// every value and verdict is the general path's. Returns false, having changed nothing,
+// every value and verdict is the general path's. In two parts (see SmallPlane):
+// triangle_plane(), then triangle_passes(), which returns false, having changed nothing,
 // when the triangle fails one of the checks that reject a mesh: the general path then
 // names the problem.
-bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, double tolerance,
-                     double zero_area, bool convexity, const Point& centre, FanVolumes& volumes,
-                     int& non_planar_face, bool& any_reflex, detail::UnitNormal* unit,
-                     bool& unit_complete) {
-  const int b = cycles.begin[f];
-  const int* ids = cycles.vertex + b;
+SmallPlane triangle_plane(const MeshView& m, const int* ids, const Point& centre, bool unit) {
+  SmallPlane q;
   const int i0 = ids[0], i1 = ids[1], i2 = ids[2];
   // A repeated vertex or position needs no test of its own here: with two equal corners,
   // two of the cross products below are opposites and the third is zero (a x a), so the
@@ -423,34 +463,45 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, double 
   const double qx = p2[0] - cx, qy = p2[1] - cy, qz = p2[2] - cz;
   // cross(u, v) component i: u[j] v[l] - u[l] v[j] with (j, l) = (i + 1, i + 2) mod 3,
   // summed over the edges a-b, b-q, q-a from zero.
-  double nx = ((0.0 + (ay * bz - az * by)) + (by * qz - bz * qy)) + (qy * az - qz * ay);
-  double ny = ((0.0 + (az * bx - ax * bz)) + (bz * qx - bx * qz)) + (qz * ax - qx * az);
-  double nz = ((0.0 + (ax * by - ay * bx)) + (bx * qy - by * qx)) + (qx * ay - qy * ax);
-  const double length = std::sqrt((nx * nx + ny * ny) + nz * nz);
-  if (!(length > zero_area)) return false;
-  const double inverse = 1.0 / length;
+  const double nx = ((0.0 + (ay * bz - az * by)) + (by * qz - bz * qy)) + (qy * az - qz * ay);
+  const double ny = ((0.0 + (az * bx - ax * bz)) + (bz * qx - bx * qz)) + (qz * ax - qx * az);
+  const double nz = ((0.0 + (ax * by - ay * bx)) + (bx * qy - by * qx)) + (qx * ay - qy * ax);
+  q.length2 = (nx * nx + ny * ny) + nz * nz;
   if (unit) {
     const double la = norm1(ax, ay, az), lb = norm1(bx, by, bz), lq = norm1(qx, qy, qz);
-    unit_normal(*unit, nx, ny, nz, length, inverse, (la * lb + lb * lq) + lq * la, 3,
-                unit_complete);
+    q.magnitude = (la * lb + lb * lq) + lq * la;
   }
-  nx *= inverse;
-  ny *= inverse;
-  nz *= inverse;
-  {
-    const Point& o = centre;
-    const double u[3] = {p2[0] - o[0], p2[1] - o[1], p2[2] - o[2]};
-    const double v[3] = {p0[0] - o[0], p0[1] - o[1], p0[2] - o[2]};
-    const double w[3] = {p1[0] - o[0], p1[1] - o[1], p1[2] - o[2]};
-    const double six_v = (u[0] * (v[1] * w[2] - v[2] * w[1]) + u[1] * (v[2] * w[0] - v[0] * w[2])) +
-                         u[2] * (v[0] * w[1] - v[1] * w[0]);
-    volumes.total += six_v;
-    volumes.absolute += std::abs(six_v);
-  }
+  q.cx = cx;
+  q.cy = cy;
+  q.cz = cz;
+  q.nx = nx;
+  q.ny = ny;
+  q.nz = nz;
+  q.degree = 3;
+  // FanVolumes::add_face(): the one tetrahedron (q, a, b) of the fan from the last corner.
+  const Point& o = centre;
+  const double u[3] = {p2[0] - o[0], p2[1] - o[1], p2[2] - o[2]};
+  const double v[3] = {p0[0] - o[0], p0[1] - o[1], p0[2] - o[2]};
+  const double w[3] = {p1[0] - o[0], p1[1] - o[1], p1[2] - o[2]};
+  q.first = (u[0] * (v[1] * w[2] - v[2] * w[1]) + u[1] * (v[2] * w[0] - v[0] * w[2])) +
+            u[2] * (v[0] * w[1] - v[1] * w[0]);
+  q.second = 0;
+  q.ok = true;
+  return q;
+}
+
+bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, const SmallPlane& q,
+                     double tolerance, bool convexity, FanVolumes& volumes, int& non_planar_face,
+                     bool& any_reflex) {
+  if (!q.ok) return false;
+  volumes.total += q.first;
+  volumes.absolute += std::abs(q.first);
+  const int b = cycles.begin[f];
+  const int* ids = cycles.vertex + b;
+  const int i0 = ids[0], i1 = ids[1], i2 = ids[2];
+  const Point &p0 = m.points[i0], &p1 = m.points[i1], &p2 = m.points[i2];
   // height(plane, p): dot(p - centroid, normal), summed in OpenMesh's order.
-  const auto height = [&](const Point& p) {
-    return (p[0] - cx) * nx + (p[1] - cy) * ny + (p[2] - cz) * nz;
-  };
+  const PlaneHeight height{q.cx, q.cy, q.cz, q.nx, q.ny, q.nz};
   if (non_planar_face < 0 &&
       !(std::abs(height(p0)) <= tolerance && std::abs(height(p1)) <= tolerance &&
         std::abs(height(p2)) <= tolerance))
@@ -475,7 +526,7 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, double 
     reflex = reflex || !(height(m.points[v]) <= tolerance);
   }
   if (polygon_across && !reflex) {
-    const FacePlane plane{Point(cx, cy, cz), Point(nx, ny, nz)};
+    const FacePlane plane{Point(q.cx, q.cy, q.cz), Point(q.nx, q.ny, q.nz)};
     for (int k = 0; k < 3 && !reflex; ++k)
       if (cycles.degree(across[k]) != 3)
         reflex = reflex_across(m, cycles, plane, across[k], from[k], to[k], tolerance);
@@ -521,29 +572,8 @@ inline bool reflex_across_small(const MeshView& m, const FaceCycles& cycles, con
 // the general path's. Returns false, having changed nothing, when the quadrilateral repeats
 // a vertex or a position or has zero area: the general path then names the problem (a
 // repeated vertex does not zero a quadrilateral's normal, so both are tested here).
-//
-// In two parts: quad_plane() reads only the corners (the plane and the fan volumes, ending in a
-// square root and a division), and nondegenerate() computes every quadrilateral's first, in a
-// loop whose iterations do not depend on each other (so that their chains of dependent
-// operations overlap), then the heights with quad_passes().
-struct QuadPlane {
-  double cx, cy, cz;     // the centroid
-  double nx, ny, nz;     // the unit normal
-  double first, second;  // six times the volumes of the fan's two tetrahedra
-  bool ok;               // false: a repeated vertex or position, or zero area (nothing else is set)
-};
-
-// height(plane, p) of a plane given by its centroid and unit normal: the same operations.
-struct PlaneHeight {
-  double cx, cy, cz, nx, ny, nz;
-  double operator()(const Point& p) const {
-    return (p[0] - cx) * nx + (p[1] - cy) * ny + (p[2] - cz) * nz;
-  }
-};
-
-QuadPlane quad_plane(const MeshView& m, const int* ids, double zero_area, const Point& centre,
-                     detail::UnitNormal* unit, bool& unit_complete) {
-  QuadPlane q;
+SmallPlane quad_plane(const MeshView& m, const int* ids, const Point& centre, bool unit) {
+  SmallPlane q;
   q.ok = false;
   const int i0 = ids[0], i1 = ids[1], i2 = ids[2], i3 = ids[3];
   if (i0 == i1 || i0 == i2 || i0 == i3 || i1 == i2 || i1 == i3 || i2 == i3) return q;
@@ -565,21 +595,19 @@ QuadPlane quad_plane(const MeshView& m, const int* ids, double zero_area, const 
                     (rz * ax - rx * az);
   const double nz = (((0.0 + (ax * by - ay * bx)) + (bx * qy - by * qx)) + (qx * ry - qy * rx)) +
                     (rx * ay - ry * ax);
-  const double length = std::sqrt((nx * nx + ny * ny) + nz * nz);
-  if (!(length > zero_area)) return q;
-  const double inverse = 1.0 / length;
+  q.length2 = (nx * nx + ny * ny) + nz * nz;
   if (unit) {
     const double la = norm1(ax, ay, az), lb = norm1(bx, by, bz), lq = norm1(qx, qy, qz),
                  lr = norm1(rx, ry, rz);
-    unit_normal(*unit, nx, ny, nz, length, inverse, ((la * lb + lb * lq) + lq * lr) + lr * la, 4,
-                unit_complete);
+    q.magnitude = ((la * lb + lb * lq) + lq * lr) + lr * la;
   }
   q.cx = cx;
   q.cy = cy;
   q.cz = cz;
-  q.nx = nx * inverse;
-  q.ny = ny * inverse;
-  q.nz = nz * inverse;
+  q.nx = nx;
+  q.ny = ny;
+  q.nz = nz;
+  q.degree = 4;
   // FanVolumes::add_face(): the fan from the last corner, tetrahedra (r, a, b), (r, b, q).
   const Point& o = centre;
   const double u[3] = {p3[0] - o[0], p3[1] - o[1], p3[2] - o[2]};
@@ -594,7 +622,7 @@ QuadPlane quad_plane(const MeshView& m, const int* ids, double zero_area, const 
   return q;
 }
 
-bool quad_passes(const MeshView& m, const FaceCycles& cycles, int f, const QuadPlane& q,
+bool quad_passes(const MeshView& m, const FaceCycles& cycles, int f, const SmallPlane& q,
                  double tolerance, bool convexity, FanVolumes& volumes, int& non_planar_face,
                  bool& any_reflex) {
   if (!q.ok) return false;
@@ -655,24 +683,32 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
   const Point centre = geometry.extent.centre;
   detail::UnitNormal* const unit = geometry.unit;
   bool unit_complete = geometry.unit_complete;
-  // Every live quadrilateral's plane first (quad_plane() changes nothing); none when there
-  // are no quadrilaterals (default-initialised: only quadrilaterals' entries are read).
-  std::unique_ptr<QuadPlane[]> quad_planes;
-  for (int f = 0; f < m.n_faces && shortcuts; ++f) {
-    if (geometry.cycles.degree(f) != 4 || !m.live_face(f)) continue;
-    if (!quad_planes) quad_planes.reset(new QuadPlane[m.n_faces]);
-    quad_planes[f] = quad_plane(m, geometry.cycles.corners(f), zero_area, centre,
-                                unit ? unit + f : nullptr, unit_complete);
+  // Every live triangle's and quadrilateral's plane first (triangle_plane() and quad_plane()
+  // change nothing; default-initialised: only these faces' entries are read).
+  std::unique_ptr<SmallPlane[]> planes;
+  if (shortcuts) {
+    planes.reset(new SmallPlane[m.n_faces]);
+    for (int f = 0; f < m.n_faces; ++f) {
+      const int n = geometry.cycles.degree(f);
+      if (n == 3)
+        planes[f] = triangle_plane(m, geometry.cycles.corners(f), centre, unit);
+      else if (n == 4)
+        planes[f] = quad_plane(m, geometry.cycles.corners(f), centre, unit);
+      else
+        planes[f].ok = false;
+    }
+    for (int f = 0; f < m.n_faces; ++f)
+      plane_root(planes[f], zero_area, unit ? unit + f : nullptr, unit_complete);
   }
   for (int f = 0; f < m.n_faces; ++f) {
     if (!m.live_face(f)) continue;
     const int n = geometry.cycles.degree(f);
     if (n == 3 && shortcuts &&
-        triangle_passes(m, geometry.cycles, f, tolerance, zero_area, convexity, centre, volumes,
-                        non_planar_face, reflex, unit ? unit + f : nullptr, unit_complete))
+        triangle_passes(m, geometry.cycles, f, planes[f], tolerance, convexity, volumes,
+                        non_planar_face, reflex))
       continue;
     if (n == 4 && shortcuts &&
-        quad_passes(m, geometry.cycles, f, quad_planes[f], tolerance, convexity, volumes,
+        quad_passes(m, geometry.cycles, f, planes[f], tolerance, convexity, volumes,
                     non_planar_face, reflex))
       continue;
     const int* ids = geometry.cycles.corners(f);
