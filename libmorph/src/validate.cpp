@@ -539,10 +539,12 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, const S
 // quadrilateral's corners off the edge found without a loop. A quadrilateral g holds the edge
 // as to -> from (the opposite halfedge); its corners off the edge are the two after `from`.
 // When g repeats a vertex (so that these could differ from the loop's), g fails its own check
-// in nondegenerate(), and that failure is the verdict whatever the reflex flag says.
+// in nondegenerate(), and that failure is the verdict whatever the reflex flag says. Always
+// inlined: quad_passes() calls it four times a face, and GCC otherwise makes it a call.
 template <class Height>
-inline bool reflex_across_small(const MeshView& m, const FaceCycles& cycles, const Height& height,
-                                int g, int from, int to, double tolerance) {
+[[gnu::always_inline]] inline bool reflex_across_small(const MeshView& m, const FaceCycles& cycles,
+                                                       const Height& height, int g, int from,
+                                                       int to, double tolerance) {
   const int gb = cycles.begin[g];
   const int* corners = cycles.vertex + gb;
   const int n = cycles.begin[g + 1] - gb;
