@@ -248,7 +248,9 @@ TEST_CASE("normal predicates: a region's slot planes agree with exact evaluation
 
 // The kernel's walks make a region's slot planes on first use (SlotCache): the same doubles
 // as slot_planes, so every walk answers as with them, or with planes formed at each test.
-// Walks from a far, fixed start and from the previous answer, on the pairs above.
+// Walks from a far, fixed start and from the previous answer, with and without the first
+// step in doubles (the kernel skips it after a walk that stayed where it started), on the
+// pairs above; a vertex answer's region must contain the direction by exact evaluation.
 TEST_CASE("normal predicates: locate with a SlotCache answers as with slot_planes") {
   using morph::detail::Location;
   const std::vector<std::pair<Mesh, Mesh>> pairs = slot_test_pairs();
@@ -260,17 +262,28 @@ TEST_CASE("normal predicates: locate with a SlotCache answers as with slot_plane
     const Polytope B = morph::detail::make_operand(b, "B");
     const auto slots = morph::detail::slot_planes(B);
     morph::detail::SlotCache cache(B);
-    int differing = 0, hint = 0;
+    int differing = 0, hint = 0, outside = 0, vertex_answers = 0;
     for (int f = 0; f < A.num_faces(); ++f) {
       const NormalRef n{&A, f};
       for (const int start : {0, B.num_vertices() - 1, hint}) {
         const Location want = morph::detail::locate(B, slots.data(), n, start);
         differing += !same(morph::detail::locate(B, cache, n, start), want);
         differing += !same(morph::detail::locate(B, nullptr, n, start), want);
+        differing += !same(morph::detail::locate(B, cache, n, start, false), want);
+        differing += !same(morph::detail::locate(B, slots.data(), n, start, false), want);
+        if (start != hint || want.kind != Location::Kind::vertex) continue;
+        ++vertex_answers;
+        const int v = want.index, begin = B.fan_begin[v], d = B.fan_begin[v + 1] - begin;
+        for (int i = 0; i < d; ++i) {
+          const NormalRef l{&B, B.fan_face[begin + i]}, r{&B, B.fan_face[begin + (i + 1) % d]};
+          outside += CGAL::sign(morph::detail::det(l.exact(), r.exact(), n.exact())) <= 0;
+        }
       }
       hint = morph::detail::location_vertex(B, morph::detail::locate(B, cache, n, hint));
     }
     CHECK(differing == 0);
+    CHECK(outside == 0);
+    CHECK(vertex_answers > 0);
     // The cache's planes (made by the walks, or here for regions they did not reach) are
     // slot_planes', bit for bit.
     int planes_differing = 0;

@@ -69,18 +69,23 @@ inline int region_test(const Polytope& P, const ArcPlane* slots, int v, const No
   bool inside = true;
   int most = -1;
   double lowest = 0;
+  // arc_filter's bound, with p's share added once: plane.error + (u.error + rounding) bounds
+  // the same error as arc_filter's sum (its margin covers the order of the additions).
+  const double p_bound = u.error + kUnitPredicateRounding;
   auto scan = [&](auto&& plane_of) {
     for (int i = 0; i < n; ++i) {
-      const ArcFilter f = arc_filter(plane_of(i), u);
-      if (!(f.value > f.bound)) inside = false;
-      if (f.value < -f.bound && f.value < lowest) {
-        lowest = f.value;
+      const ArcPlane& plane = plane_of(i);
+      const double value = u.x * plane.x + u.y * plane.y + u.z * plane.z;
+      const double bound = plane.error + p_bound;
+      if (!(value > bound)) inside = false;
+      if (value < -bound && value < lowest) {
+        lowest = value;
         most = i;
       }
     }
   };
   if (slots)
-    scan([&](int i) { return slots[b + i]; });
+    scan([&](int i) -> const ArcPlane& { return slots[b + i]; });
   else
     scan([&](int i) {
       return cross_plane(P.unit_normals[fan[i]], P.unit_normals[fan[i + 1 == n ? 0 : i + 1]]);

@@ -118,8 +118,8 @@ inline int orient_arc(const Polytope& P, int e, const ArcPlane& plane, const Nor
 /// contains it in its interior (the contributing vertex), the edge whose arc contains it, or the
 /// facet whose normal has its direction. The walk starts at vertex `hint`, takes one step up
 /// the support function in doubles (only to choose where to start; not when `step` is false,
-/// for a hint already chosen by support), then walks exactly from region to region; the answer
-/// is exact and does not depend on the hint. Expected O(distance walked).
+/// for a hint already chosen by support or likely the answer), then walks exactly from region
+/// to region; the answer is exact and does not depend on the hint. Expected O(distance walked).
 Location locate(const Polytope& P, const ArcPlane* slots, const NormalRef& p, int hint,
                 bool step = true);
 

@@ -172,11 +172,12 @@ void edge_facets(const Polytope& A, int a, const ArcPlane& plane_a, const Polyto
   // The parallelogram of a crossing with edge e of B, whose arc's right facet's normal is on
   // side `side_of_b` of a's great circle.
   auto emit = [&](int e, int side_of_b) {
-    const int ub = B.edges[e].from, wb = B.edges[e].to;
-    const std::uint64_t quad[2][4] = {
-        {pair_key(wa, wb), pair_key(wa, ub), pair_key(ua, ub), pair_key(ua, wb)},   // side < 0
-        {pair_key(wa, ub), pair_key(wa, wb), pair_key(ua, wb), pair_key(ua, ub)}};  // side > 0
-    const auto& q = quad[side_of_b > 0];
+    // b's ends in the order (from, to) when side > 0, else (to, from) (a crossing's side is
+    // never 0).
+    int ub = B.edges[e].from, wb = B.edges[e].to;
+    if (side_of_b <= 0) std::swap(ub, wb);
+    const std::uint64_t q[4] = {pair_key(wa, ub), pair_key(wa, wb), pair_key(ua, wb),
+                                pair_key(ua, ub)};
     out.corners.insert(out.corners.end(), q, q + 4);
     out.sizes.push_back(4);
     out.origins.push_back({FacetKind::edge,
@@ -437,13 +438,19 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
                int begin, int end, FacetBuffer& out, int& hint) {
       const bool translated = P == &A;
       SlotCache* const slots = cache_q ? &q_slots->local() : nullptr;
+      // Whether the previous walk ended where it started: then this one likely does too (a
+      // fine map walked on a coarse one: runs of facets in one region), and its first region
+      // test costs less than locate's step in doubles would.
+      bool stayed = false;
       for (int f = begin; f < end; ++f) {
         const int start = starts ? (*starts)(f) : -1;
         if (start >= 0) hint = start;
+        const bool step = start < 0 && !stayed;
         const NormalRef n{P, f};
-        loc[f] = slots ? locate(*Q, *slots, n, hint, start < 0)
-                       : locate(*Q, nullptr, n, hint, start < 0);
-        hint = location_vertex(*Q, loc[f]);
+        loc[f] = slots ? locate(*Q, *slots, n, hint, step) : locate(*Q, nullptr, n, hint, step);
+        const int found = location_vertex(*Q, loc[f]);
+        stayed = found == hint;
+        hint = found;
         if (translated || loc[f].kind != Location::Kind::face)
           facet_at_normal(*P, f, *Q, loc[f], translated, out);
       }
