@@ -263,8 +263,11 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
       // One facet (the group is named by it, and has the edge): its corners from the one
       // after the shared edge on, as the edge's ends are on the plane when the groups
       // already meet there. Which corner fails first does not change the answer.
-      const int d = soup.degree(g);
-      for (int i = 0, c = k.next[k.next[edge]]; i < d; ++i, c = k.next[c])
+      // A facet's corners are consecutive (next is the one after, or the first after the
+      // last): found so rather than through `next`, whose loads would delay the first test.
+      const int b = soup.begin[g], e = soup.begin[g + 1], d = e - b;
+      int c = edge + 2 >= e ? edge + 2 - d : edge + 2;  // d >= 3
+      for (int i = 0; i < d; ++i, c = c + 1 == e ? b : c + 1)
         if (off(c)) return false;
       return true;
     }
