@@ -113,6 +113,43 @@ TEST_CASE("clean_mesh merges a split facet and drops the vertices in the middle 
   CHECK(std::count(source.begin(), source.end(), 2) == 0);
 }
 
+// Vertices in the middle of edges (two facets around them) go, whether or not any group
+// merges: when none does, clean_mesh tells them by their number of outgoing corners alone,
+// and otherwise walks the fans of the vertices on merged groups. Every subset of the 12
+// edges gets its midpoint, with no face split (nothing merges), the top and back split
+// (their halves merge, and some midpoints are on them) or half the faces split.
+TEST_CASE("clean_mesh drops vertices in the middle of edges, with and without merges") {
+  const std::vector<std::array<int, 2>> edges = {{0, 1}, {2, 3}, {4, 5}, {6, 7}, {0, 2}, {1, 3},
+                                                 {4, 6}, {5, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
+  std::vector<V3<double>> points = cube_points();
+  for (const auto& [a, b] : edges)
+    points.push_back({(points[a].x + points[b].x) / 2, (points[a].y + points[b].y) / 2,
+                      (points[a].z + points[b].z) / 2});
+  const long fallbacks = morph::detail::clean_mesh_hull_fallbacks();
+  for (const std::set<int>& split : {std::set<int>{}, std::set<int>{1, 3}, std::set<int>{0, 2, 5}})
+    for (int mask = 0; mask < 1 << 12; ++mask) {
+      std::vector<int> begin;
+      const std::vector<int> cube = cube_soup(split, {}, begin);
+      // Each facet with the midpoints of its chosen edges inserted.
+      std::vector<int> corners, new_begin{0};
+      for (std::size_t f = 0; f + 1 < begin.size(); ++f) {
+        for (int c = begin[f]; c < begin[f + 1]; ++c) {
+          const int u = cube[c], w = cube[c + 1 == begin[f + 1] ? begin[f] : c + 1];
+          corners.push_back(u);
+          for (int e = 0; e < 12; ++e)
+            if ((mask >> e & 1) && std::min(u, w) == edges[e][0] && std::max(u, w) == edges[e][1])
+              corners.push_back(8 + e);
+        }
+        new_begin.push_back(static_cast<int>(corners.size()));
+      }
+      CAPTURE(mask);
+      CAPTURE(split.size());
+      std::vector<int> source;
+      check_cube(clean_mesh(points, new_begin, corners, &source));
+    }
+  CHECK(morph::detail::clean_mesh_hull_fallbacks() == fallbacks);
+}
+
 TEST_CASE("clean_mesh merges some groups and keeps the others") {
   const std::vector<V3<double>> points = cube_points();
   for (int mask = 0; mask < 64; ++mask) {

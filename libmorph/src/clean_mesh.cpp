@@ -74,6 +74,9 @@ class Ints {
 struct Connectivity {
   Ints face, next, prev, twin;
   Ints first_out;  // a corner leaving each point (-1: none); `connect`'s is the first one
+  // `connect`'s only: where each point's outgoing corners start in its counting sort (of
+  // num_points + 1 elements), so point v has out_begin[v + 1] - out_begin[v] of them.
+  std::vector<int> out_begin;
 };
 
 // Chunk sizes of the parallel loops: large enough that a chunk pays for its task, small
@@ -93,7 +96,7 @@ constexpr int kFanGrain = 512;
 /// The facet, next and previous corner of every corner (no twins yet).
 Connectivity facet_cycles(const Soup& soup) {
   const int nc = static_cast<int>(soup.vertex.size());
-  Connectivity k{Ints(nc), Ints(nc), Ints(nc), {}, {}};
+  Connectivity k{Ints(nc), Ints(nc), Ints(nc), {}, {}, {}};
   parallel_chunks(soup.size(), kFacetGrain, [&](int first, int last) {
     // Plain pointers: the writes through them could alias the captured arrays' own pointers.
     int *face = k.face.data(), *next = k.next.data(), *prev = k.prev.data();
@@ -134,7 +137,8 @@ std::optional<Connectivity> connect(int num_points, const Soup& soup) {
   k.twin = Ints(nc);  // each corner's twin is set below (each is the prev of one corner)
   k.first_out = Ints(num_points);
   // Outgoing corners of each vertex (counting sort).
-  std::vector<int> out_begin(num_points + 1, 0);
+  std::vector<int>& out_begin = k.out_begin;
+  out_begin.assign(num_points + 1, 0);
   Ints out(nc);
   for (int c = 0; c < nc; ++c) ++out_begin[soup.vertex[c]];
   std::partial_sum(out_begin.begin(), out_begin.end(), out_begin.begin());  // ends, until filled
@@ -259,8 +263,11 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
       // One facet (the group is named by it, and has the edge): its corners from the one
       // after the shared edge on, as the edge's ends are on the plane when the groups
       // already meet there. Which corner fails first does not change the answer.
-      const int d = soup.degree(g);
-      for (int i = 0, c = k.next[k.next[edge]]; i < d; ++i, c = k.next[c])
+      // A facet's corners are consecutive (next is the one after, or the first after the
+      // last): found so rather than through `next`, whose loads would delay the first test.
+      const int b = soup.begin[g], e = soup.begin[g + 1], d = e - b;
+      int c = edge + 2 >= e ? edge + 2 - d : edge + 2;  // d >= 3
+      for (int i = 0; i < d; ++i, c = c + 1 == e ? b : c + 1)
         if (off(c)) return false;
       return true;
     }
@@ -396,6 +403,22 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
         if (alone) return false;
       }
   const int nc = static_cast<int>(soup.vertex.size());
+  const int np = static_cast<int>(points.size());
+  // Vertices keep their place when at least three groups meet there. A vertex on no facet
+  // of a group of several has as many groups around it as it has outgoing corners: its fan
+  // (one, `connect` checked) passes each outgoing corner once, each in its own facet (no
+  // facet of the soups simplify gets has a point twice: clean_mesh sends those to the
+  // hull, and the hull's polygons are simple), and each of those facets is its own group.
+  // So when no group merged, something changes only if a vertex has one or two outgoing
+  // corners (a vertex in the middle of an edge; 1 cannot happen in a closed manifold of
+  // polygons), read off `connect`'s counting sort without walking any fan.
+  const int* const out_begin = k.out_begin.data();
+  changed = groups.merged;
+  for (int v = 0; v < np && !changed; ++v) {
+    const int n = out_begin[v + 1] - out_begin[v];
+    changed = n > 0 && n < 3;
+  }
+  if (!changed) return true;
   Ints corner_group(nc);  // looked up several times per corner below
   parallel_chunks(nf, kFacetGrain, [&](int first, int last) {
     for (int f = first; f < last; ++f)
@@ -403,16 +426,25 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
                 groups.of[f]);
   });
   const auto group = [&](int c) { return corner_group[c]; };
-  // Vertices keep their place when at least three groups meet there (each vertex walks
-  // its own fan: in parallel).
-  const int np = static_cast<int>(points.size());
+  // Only the vertices on a facet of a group of several walk their fan to count the groups
+  // around them (each its own: in parallel); the others count their outgoing corners.
+  std::vector<char> walk;
+  if (groups.merged) {
+    walk.assign(np, 0);
+    for (int f = 0; f < nf; ++f)
+      if (groups.of[f] != f || groups.next_member[f] >= 0)
+        for (int c = soup.begin[f]; c < soup.begin[f + 1]; ++c) walk[soup.vertex[c]] = 1;
+  }
   std::vector<char> keep(np, 0);
-  std::atomic<bool> dropped{false};
   parallel_chunks(np, kFanGrain, [&](int first, int last) {
-    bool here = false;
     for (int v = first; v < last; ++v) {
+      const int n = out_begin[v + 1] - out_begin[v];
+      if (n == 0) continue;
+      if (walk.empty() || !walk[v]) {
+        keep[v] = n >= 3;
+        continue;
+      }
       const int c = k.first_out[v];
-      if (c < 0) continue;
       int g1 = -1, g2 = -1, distinct = 0, e = c;
       do {
         const int g = group(e);
@@ -426,12 +458,8 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
         e = k.twin[k.prev[e]];
       } while (e != c && distinct < 3);
       keep[v] = distinct >= 3;
-      here = here || !keep[v];
     }
-    if (here) dropped.store(true, std::memory_order_relaxed);
   });
-  changed = groups.merged || dropped.load();
-  if (!changed) return true;
   // The boundary of each group, walked from its first boundary corner.
   Soup out;
   // No more polygons and corners than the soup's: filled up to `polygons` and `size`

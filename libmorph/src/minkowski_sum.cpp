@@ -710,9 +710,11 @@ LabelledMesh sum_mesh(const Polytope& A, const Polytope& B, const SumFacets& fac
   // Initialised in place: OpenMesh meshes have no move assignment, only a deep copy.
   LabelledMesh out{clean_mesh(points, facets.face_begin, std::move(corners), &source), {}};
   // A face with no source (a triangle of the hull fallback that no facet owns) has no origin.
-  out.origins.reserve(source.size());
-  for (int f : source)
-    out.origins.push_back(f >= 0 ? facets.origins[f] : FacetOrigin{FacetKind::edge, {}, {}});
+  // Sized first and written in place (push_back is not inlined: a call per face).
+  out.origins.resize(source.size());
+  FacetOrigin* const origin = out.origins.data();
+  for (std::size_t i = 0; i < source.size(); ++i)
+    origin[i] = source[i] >= 0 ? facets.origins[source[i]] : FacetOrigin{FacetKind::edge, {}, {}};
   return out;
 }
 
