@@ -653,7 +653,19 @@ V3<double> round_sum_with_precise(const Polytope& E, int i, const V3<double>& b)
     const V3<ExactN>& x = E.exact_points.X(i);
     const ExactN& w = E.exact_points.W(i);
     const ExactN& xk = k == 0 ? x.x : k == 1 ? x.y : x.z;
-    out[k] = round_quotient(xk + ExactN(bc[k]) * w, w, Interval(ec[k] + bc[k]));
+    const ExactN numerator = xk + ExactN(bc[k]) * w;
+    if (CGAL::sign(numerator) == CGAL::ZERO) {  // E(i) = -b exactly: the sum is 0 (+0, as e + b)
+      out[k] = 0.0;
+      continue;
+    }
+    // Where round_quotient starts: e + b is within an ulp of e of the sum (e is E(i)
+    // rounded), a good start unless e and b cancel, when that ulp is many of the sum's;
+    // given as that wide an interval, round_quotient starts from the quotient of the
+    // exact numerator's and W's doubles instead (a few ulps off), rather than searching
+    // from e + b in vain and then dividing rationals (a gcd).
+    const double s = ec[k] + bc[k];
+    const double spread = (std::abs(ec[k]) + std::abs(s)) * 0x1p-52;
+    out[k] = round_quotient(numerator, w, Interval(s - spread, s + spread));
   }
   return {out[0], out[1], out[2]};
 }
