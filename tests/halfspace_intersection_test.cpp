@@ -315,6 +315,12 @@ TEST_CASE("halfspace_intersection: exact vertices plus doubles round as their ra
         CHECK(rounds_exactly(X, W, x + b));
         CHECK(rounds_exactly(X, W, 0.0));  // a wrong estimate
         CHECK(rounds_exactly(X, W, -1e200));
+        // As an opening's sums give it when e and b cancel: e + b widened by an ulp of e,
+        // from which round_quotient starts at the quotient of X's and W's doubles.
+        const double s = x + b, spread = (std::abs(x) + std::abs(s)) * 0x1p-52;
+        const double want = round_to_nearest(Exact(X) / Exact(W));
+        const double got = round_quotient(X, W, Interval(s - spread, s + spread));
+        CHECK(std::memcmp(&got, &want, sizeof got) == 0);
       }
     }
   }
