@@ -1397,29 +1397,36 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   for (int t = 0; t < nt; ++t)
     for (int k = 0; k < 3; ++k) some_triangle[s.corner[t][k]] = t;
   // Facet f's cycle of vertices is face_vertex[face_begin[f] .. face_begin[f + 1]).
-  std::vector<int> face_begin(1, 0), face_vertex, face_halfspace;
-  face_vertex.reserve(3 * static_cast<std::size_t>(nt));
+  // The walk around each plane visits the triangles at it once (a closed surface, checked
+  // above): 3 nt entries at most, written by index (push_back was not inlined here).
+  std::vector<int> face_begin(1, 0), face_vertex(3 * static_cast<std::size_t>(nt)), face_halfspace;
+  face_begin.reserve(n + 1);
+  face_halfspace.reserve(n);
+  std::size_t used = 0;
   for (int p = 0; p < n; ++p) {
     if (some_triangle[p] < 0) continue;
-    const std::size_t start = face_vertex.size();
+    const std::size_t start = used;
     int t = some_triangle[p], steps = 0;
     do {
       const int g = group[t];
-      if (face_vertex.size() == start || face_vertex.back() != g) face_vertex.push_back(g);
+      if (used == start || face_vertex[used - 1] != g) {
+        if (used == face_vertex.size()) return std::nullopt;  // (not a closed surface)
+        face_vertex[used++] = g;
+      }
       int k = 0;
       while (k < 3 && s.corner[t][k] != p) ++k;
       if (k == 3 || ++steps > nt) return std::nullopt;
       t = s.across[t][k];
     } while (t != some_triangle[p]);
-    while (face_vertex.size() > start + 1 && face_vertex[start] == face_vertex.back())
-      face_vertex.pop_back();
-    if (face_vertex.size() < start + 3) {
-      face_vertex.resize(start);
+    while (used > start + 1 && face_vertex[start] == face_vertex[used - 1]) --used;
+    if (used < start + 3) {
+      used = start;
       continue;
     }
-    face_begin.push_back(static_cast<int>(face_vertex.size()));
+    face_begin.push_back(static_cast<int>(used));
     face_halfspace.push_back(p);
   }
+  face_vertex.resize(used);
   const int nf = static_cast<int>(face_halfspace.size());
   if (nf < 4) return std::nullopt;
   // Precise vertices, for the checks below (a second filter stage) and the rounding; exact
@@ -1624,19 +1631,20 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   {
     std::vector<int> facet_of(n, -1);  // by half-space
     for (int f = 0; f < nf; ++f) facet_of[face_halfspace[f]] = f;
-    std::vector<int> sorted_begin(1, 0), sorted_vertex, sorted_halfspace;
-    sorted_vertex.reserve(face_vertex.size());
+    std::vector<int> sorted_begin(1, 0), sorted_vertex(face_vertex.size()), sorted_halfspace;
+    sorted_begin.reserve(nf + 1);
     sorted_halfspace.reserve(nf);
+    int written = 0;  // (written by index, as face_vertex)
     for (int p = 0; p < n; ++p) {
       const int f = facet_of[p];
       if (f < 0) continue;
-      const auto first = sorted_vertex.end() - sorted_vertex.begin();
+      const int first = written;
       for (int j = face_begin[f]; j < face_begin[f + 1]; ++j)
-        sorted_vertex.push_back(rank[face_vertex[j]]);
+        sorted_vertex[written++] = rank[face_vertex[j]];
       std::rotate(sorted_vertex.begin() + first,
-                  std::min_element(sorted_vertex.begin() + first, sorted_vertex.end()),
-                  sorted_vertex.end());
-      sorted_begin.push_back(static_cast<int>(sorted_vertex.size()));
+                  std::min_element(sorted_vertex.begin() + first, sorted_vertex.begin() + written),
+                  sorted_vertex.begin() + written);
+      sorted_begin.push_back(written);
       sorted_halfspace.push_back(p);
     }
     face_begin = std::move(sorted_begin);
