@@ -764,15 +764,24 @@ bool clockwise(const std::vector<int>& cyc, const std::vector<HVertex>& vertex,
 /// cannot decide.
 class VertexExactPoints final : public LazyExactPoints {
  public:
-  /// Vertex r is vertex[order[r]]. The polytope outlives the half-spaces that `planes`
-  /// point at: the planes of the vertices still without exact coordinates are copied with
-  /// their exact values (the others are never read).
+  /// Vertex r is vertex[order[r]]. The polytope outlives the half-spaces and known points
+  /// that `planes` and the vertices point at, unless `owner` keeps them (intersect_halfspaces):
+  /// without it, the planes of the vertices still without exact coordinates are copied with
+  /// their exact values (the others are never read), and so are the known points.
   VertexExactPoints(const std::vector<Plane>& planes, std::vector<HVertex> vertex,
-                    std::vector<int> order)
-      : planes_(planes.size()),
+                    std::vector<int> order, std::shared_ptr<const void> owner)
+      : planes_(owner ? planes : std::vector<Plane>(planes.size())),
         vertex_(std::move(vertex)),
         order_(std::move(order)),
-        once_(std::make_unique<std::once_flag[]>(order_.size())) {
+        once_(std::make_unique<std::once_flag[]>(order_.size())),
+        owner_(std::move(owner)) {
+    if (owner_) return;
+    parallel_chunks(static_cast<int>(vertex_.size()), 256, [&](int begin, int end) {
+      for (int i = begin; i < end; ++i) {
+        HVertex& v = vertex_[i];
+        if (v.X && !v.made) set_exact(v, *v.X, *v.W);
+      }
+    });
     for (const HVertex& v : vertex_) {
       if (v.X) continue;
       for (int i : v.planes) {
@@ -797,6 +806,7 @@ class VertexExactPoints final : public LazyExactPoints {
   mutable std::vector<HVertex> vertex_;  // each written once, under its once_flag
   std::vector<int> order_;
   std::unique_ptr<std::once_flag[]> once_;
+  std::shared_ptr<const void> owner_;  // of what planes_ and vertex_ point at, or null
 };
 
 /// The exact points of the intersection's polytope, whose vertex r is vertex[order[r]]
@@ -804,7 +814,8 @@ class VertexExactPoints final : public LazyExactPoints {
 /// coordinates, or, when `eager`, all computed now and without precise coordinates (the
 /// route before, which tests compare with).
 ExactPoints polytope_points(const std::vector<Plane>& planes, std::vector<HVertex>& vertex,
-                            const std::vector<int>& order, bool eager) {
+                            const std::vector<int>& order, bool eager,
+                            std::shared_ptr<const void> owner) {
   const int nv = static_cast<int>(order.size());
   ExactPoints exact;
   if (eager) {
@@ -835,15 +846,8 @@ ExactPoints polytope_points(const std::vector<Plane>& planes, std::vector<HVerte
       p.valid = true;
     }
   }
-  // A known point's exact coordinates are the KnownPoints', which the polytope outlives:
-  // copied (what set_known did for every one before).
-  parallel_chunks(nv, 256, [&](int begin, int end) {
-    for (int r = begin; r < end; ++r) {
-      HVertex& v = vertex[order[r]];
-      if (v.X && !v.made) set_exact(v, *v.X, *v.W);
-    }
-  });
-  exact.lazy = std::make_shared<VertexExactPoints>(planes, std::move(vertex), order);
+  exact.lazy =
+      std::make_shared<VertexExactPoints>(planes, std::move(vertex), order, std::move(owner));
   return exact;
 }
 
@@ -1146,6 +1150,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
                                             const std::vector<Plane>& planes,
                                             const PrecisePlanes& precise, const KnownPoints& known,
                                             DualSurface s, const IntersectOptions& options,
+                                            const std::shared_ptr<const void>& owner,
                                             bool* repaired = nullptr) {
   const bool with_polytope = options.polytope;
   const int nt = static_cast<int>(s.corner.size());
@@ -1331,7 +1336,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     s.far_side = std::move(far_side);
     if (!repair_surface(planes, precise, known, s, edges)) return std::nullopt;
     *repaired = true;
-    return build_verified(hs, planes, precise, known, std::move(s), options);
+    return build_verified(hs, planes, precise, known, std::move(s), options, owner);
   }
   std::vector<int> group(nt, -1), seed;
   {
@@ -1696,7 +1701,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   if (with_polytope) {
     std::vector<V3<ExactN>> normals(nf);
     for (int f = 0; f < nf; ++f) normals[f] = hs[face_halfspace[f]].normal;
-    ExactPoints points = polytope_points(planes, vertex, order, options.eager_exact);
+    ExactPoints points = polytope_points(planes, vertex, order, options.eager_exact, owner);
     Polytope p;
     if (options.direct_polytope) {
       p = verified_polytope(rp.points, std::move(points), face_begin, face_vertex,
@@ -2419,7 +2424,8 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const PrecisePlan
 
 MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<double>& hint,
                                    const IntersectOptions& options, const KnownPoints& known,
-                                   const ExpectedVertices& expected) {
+                                   const ExpectedVertices& expected,
+                                   std::shared_ptr<const void> owner) {
   MaybePolytope out;
   const std::vector<Plane> planes = planes_of(hs);
   V3<Exact> o = to_exact(hint);
@@ -2448,7 +2454,7 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
     bool repaired = false;
     if (auto built = build_verified(hs, planes, precise, known,
                                     expected_surface(planes, precise, known, expected), options,
-                                    &repaired)) {
+                                    owner, &repaired)) {
       built->route = repaired ? HullRoute::repaired : HullRoute::expected;
       return std::move(*built);
     }
@@ -2460,7 +2466,7 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
       const auto outcome = IncrementalHull(planes, precise, known, o_double, reach).run(s);
       if (outcome == IncrementalHull::Outcome::too_small) continue;
       if (outcome == IncrementalHull::Outcome::hull) {
-        if (auto built = build_verified(hs, planes, precise, known, std::move(s), options)) {
+        if (auto built = build_verified(hs, planes, precise, known, std::move(s), options, owner)) {
           built->route = HullRoute::incremental;
           return std::move(*built);
         }
@@ -2468,12 +2474,12 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
       break;
     }
   }
-  auto built = build_verified(hs, planes, precise, known, exact_dual_hull(planes, o), options);
+  auto built =
+      build_verified(hs, planes, precise, known, exact_dual_hull(planes, o), options, owner);
   if (!built) throw error("internal error: the exact dual hull of an erosion failed its own check");
   built->route = HullRoute::exact;
   return std::move(*built);
 }
-
 
 bool round_precise_sum(const DD& X, double error, const DD& W, double w_error, double b,
                        double& out) {
