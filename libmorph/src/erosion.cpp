@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <numeric>
 #include <optional>
 #include <vector>
@@ -338,8 +339,12 @@ MaybePolytope intersect(const ErosionInput& in, const IntersectOptions& options)
 
 MaybePolytope erode_polytope(const Polytope& A, const Polytope& B,
                              const IntersectOptions& options) {
-  // Facet f of A is half-space f: A's fans are the polygons of the guess.
-  return intersect(erosion_input(A, B, SumOfB::no, {A.fan_begin, A.fan_face}), options);
+  // Facet f of A is half-space f: A's fans are the polygons of the guess. The input is
+  // shared with the result, whose lazy exact points (an opening) read its planes and known
+  // points rather than copies.
+  const auto in = std::make_shared<const ErosionInput>(
+      erosion_input(A, B, SumOfB::no, {A.fan_begin, A.fan_face}));
+  return intersect_halfspaces(in->halfspaces, in->hint, options, in->known, in->expected, in);
 }
 
 MaybePolytope erode_sum(const Polytope& S, const Polytope& A, const Polytope& B,

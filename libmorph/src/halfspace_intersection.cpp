@@ -66,11 +66,20 @@ ExactN integer_n(const CGAL::Gmpz& z) {
 /// Runs of the incremental hull, each with a reach 2^20 times larger, before the exact route.
 constexpr int kReachAttempts = 3;
 
-/// A half-space as the homogeneous plane <n, x> <= d (the HalfSpace times its
-/// denominator, so both are dyadic), with interval copies for the filters.
-struct Plane {
+/// A plane's exact normal and offset, where they are not a HalfSpace's own.
+struct ExactPlane {
   V3<ExactN> n;
   ExactN d;
+};
+
+/// A half-space as the homogeneous plane <*n, x> <= *d (the HalfSpace times its
+/// denominator, so both are dyadic), with interval copies for the filters. n and d point
+/// at the HalfSpace's normal and offset when its denominator is 1 (the usual case: no Mpzf
+/// copied per plane, where the filters decide nearly everything), else at `scaled`.
+struct Plane {
+  const V3<ExactN>* n = nullptr;
+  const ExactN* d = nullptr;
+  std::shared_ptr<const ExactPlane> scaled;
   V3<Interval> ni;
   Interval di;
   // Its normal's or offset's double-double copy, when it has one (denominator 1).
@@ -99,19 +108,26 @@ std::vector<Plane> planes_of(const std::vector<HalfSpace>& hs) {
     for (int i = begin; i < end; ++i) {
       Plane& p = planes[i];
       const ExactN& q = hs[i].denominator;
-      p.n = q == 1 ? hs[i].normal
-                   : V3<ExactN>{hs[i].normal.x * q, hs[i].normal.y * q, hs[i].normal.z * q};
-      p.d = hs[i].offset;
+      if (q == 1) {
+        p.n = &hs[i].normal;
+        p.d = &hs[i].offset;
+      } else {
+        // (The offset is the numerator: the plane is the HalfSpace times q.)
+        p.scaled = std::make_shared<const ExactPlane>(
+            ExactPlane{{hs[i].normal.x * q, hs[i].normal.y * q, hs[i].normal.z * q}, hs[i].offset});
+        p.n = &p.scaled->n;
+        p.d = &p.scaled->d;
+      }
       if (q == 1 && (hs[i].has_normal_dd || hs[i].has_offset_dd)) p.source = &hs[i];
       if (q == 1 && hs[i].has_normal_dd) {
         // The normal's enclosure from its double-double copy (cheaper than from Mpzf).
         const auto& c = hs[i].normal_dd;
         p.ni = {neighbours_interval(c[0]), neighbours_interval(c[1]), neighbours_interval(c[2])};
       } else {
-        p.ni = to_interval_n(p.n);
+        p.ni = to_interval_n(*p.n);
       }
-      p.di =
-          q == 1 && hs[i].has_offset_dd ? neighbours_interval(hs[i].offset_dd) : to_interval_n(p.d);
+      p.di = q == 1 && hs[i].has_offset_dd ? neighbours_interval(hs[i].offset_dd)
+                                           : to_interval_n(*p.d);
     }
   });
   return planes;
@@ -157,7 +173,7 @@ bool strictly_inside(const std::vector<Plane>& planes, const V3<double>& o) {
     const V3<ExactN> oe = to_exact_n(o);
     for (int i = begin; i < end && inside; ++i) {
       int s = interval_sign(planes[i].di - dot(planes[i].ni, oi));
-      if (s == 2) s = CGAL::sign(planes[i].d - dot(planes[i].n, oe));
+      if (s == 2) s = CGAL::sign(*planes[i].d - dot(*planes[i].n, oe));
       if (s <= 0) inside = false;
     }
   });
@@ -167,14 +183,23 @@ bool strictly_inside(const std::vector<Plane>& planes, const V3<double>& o) {
 /// A vertex of the intersection in homogeneous coordinates: X / W with W > 0, the meet
 /// of three of the planes. The exact coordinates are computed only where the filters
 /// (intervals, then double-double) cannot decide, or for a polytope chained further.
+/// Exact homogeneous coordinates of a vertex.
+struct ExactCoordinates {
+  V3<ExactN> X;
+  ExactN W;
+};
 struct HVertex {
   std::array<int, 3> planes;
   V3<Interval> Xi;
   Interval Wi;
   V3<Interval> xi;  // Xi / Wi
-  bool has_exact = false;
-  V3<ExactN> X;
-  ExactN W;
+  // The exact coordinates, once known (X not null): a known point's are KnownPoints' own
+  // (not copied: most are never read), another's are made on first need into `made`. Off
+  // the vertex itself (four Mpzf are 350 bytes), which the flips and the check create,
+  // move and reset by the thousand while exact values are rarely read at all.
+  const V3<ExactN>* X = nullptr;
+  const ExactN* W = nullptr;
+  std::unique_ptr<ExactCoordinates> made;
   int known = -1;  // the known point it is (KnownPoints), if any
   // X and W times some positive factor in double-double, within ex and ew of the exact
   // ones times that factor (make_precise); only when `precise`.
@@ -263,9 +288,8 @@ void set_known(const KnownPoints& known, int k, HVertex& v) {
   v.Xi = known.Xi[k];
   v.Wi = known.Wi[k];
   v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
-  v.X = known.X[k];
-  v.W = known.W[k];
-  v.has_exact = true;
+  v.X = &known.X[k];
+  v.W = &known.W[k];
 }
 
 /// A vertex of three planes taken from a known point when the three pass through one (and
@@ -301,12 +325,21 @@ bool known_through(const KnownPoints& known, int i, const HVertex& v) {
   return v.known >= 0 && known.passes(i, v.known);
 }
 
+/// Gives v exact coordinates of its own (`made`).
+void set_exact(HVertex& v, V3<ExactN> X, ExactN W) {
+  v.made = std::make_unique<ExactCoordinates>(ExactCoordinates{std::move(X), std::move(W)});
+  v.X = &v.made->X;
+  v.W = &v.made->W;
+}
+
 /// Computes the exact coordinates of a vertex, once.
 void make_exact(const std::vector<Plane>& planes, HVertex& v) {
-  if (v.has_exact) return;
+  if (v.X) return;
   const Plane &a = planes[v.planes[0]], &b = planes[v.planes[1]], &c = planes[v.planes[2]];
-  meet(a.n, a.d, b.n, b.d, c.n, c.d, v.X, v.W);
-  v.has_exact = true;
+  v.made = std::make_unique<ExactCoordinates>();
+  meet(*a.n, *a.d, *b.n, *b.d, *c.n, *c.d, v.made->X, v.made->W);
+  v.X = &v.made->X;
+  v.W = &v.made->W;
 }
 
 // The precise stage. Every value below is a polynomial in precise components (a plane's
@@ -384,7 +417,7 @@ struct PrecisePlane {
 PrecisePlane precise_plane(const Plane& plane) {
   PrecisePlane p;
   const HalfSpace* h = plane.source;
-  p.valid = precise_scaled({&plane.n.x, &plane.n.y, &plane.n.z, &plane.d}, 0, 3, p.c,
+  p.valid = precise_scaled({&plane.n->x, &plane.n->y, &plane.n->z, plane.d}, 0, 3, p.c,
                            h && h->has_normal_dd ? &h->normal_dd : nullptr,
                            h && h->has_offset_dd ? &h->offset_dd : nullptr);
   return p;
@@ -464,10 +497,10 @@ void make_precise(const PrecisePlanes& planes, HVertex& v,
       const double d = x.to_double();
       return std::isfinite(d) && x == ExactN(d);
     };
-    v.doubles = v.W.is_one() && is_double(v.X.x) && is_double(v.X.y) && is_double(v.X.z);
+    v.doubles = v.W->is_one() && is_double(v.X->x) && is_double(v.X->y) && is_double(v.X->z);
     if (v.doubles) return;  // (a closing's vertices, A's own)
     std::array<DD, 4> c;
-    if (!precise_scaled({&v.X.x, &v.X.y, &v.X.z, &v.W}, 3, 4, c)) return;
+    if (!precise_scaled({&v.X->x, &v.X->y, &v.X->z, v.W}, 3, 4, c)) return;
     v.px = {c[0], c[1], c[2]};
     v.pw = c[3];
     v.ex = {kPlaneRelative * std::abs(c[0].hi), kPlaneRelative * std::abs(c[1].hi),
@@ -530,7 +563,9 @@ int side_filter(const Plane& p, const PrecisePlanes& precise, int i, const HVert
   const PrecisePlane& q = precise[i];
   return q.valid ? precise_side(q, v) : 2;
 }
-int side_exact(const Plane& p, const HVertex& v) { return CGAL::sign(dot(p.n, v.X) - p.d * v.W); }
+int side_exact(const Plane& p, const HVertex& v) {
+  return CGAL::sign(dot(*p.n, *v.X) - *p.d * *v.W);
+}
 
 /// Sign of <n, x> - d for plane i at a vertex: intervals, then the precise stage (the
 /// vertex made precise when first needed there; a known point skips it, as in
@@ -565,7 +600,7 @@ int compare_filter(const Plane& p, const PrecisePlanes& precise, int i, const HV
   return q.valid ? precise_compare(q, u, v) : 2;
 }
 int compare_exact(const Plane& p, const HVertex& u, const HVertex& v) {
-  return CGAL::sign(dot(p.n, u.X) * v.W - dot(p.n, v.X) * u.W);
+  return CGAL::sign(dot(*p.n, *u.X) * *v.W - dot(*p.n, *v.X) * *u.W);
 }
 
 /// Exact vertex coordinates made on first use, by whichever thread needs them first (each
@@ -600,8 +635,12 @@ double step_away(double r, bool away) {
 /// X / W rounded to nearest (ties to even) from precise coordinates, when their enclosure
 /// lies strictly between two rounding midpoints (round-to-nearest); false otherwise (too
 /// close to a midpoint, or out of range): the exact rounding decides. X is within ex of
-/// the exact X, W within ew (both times the vertex's factor).
-[[gnu::flatten]] bool round_precise(const DD& X, double ex, const DD& W, double ew, double& out) {
+/// the exact X, W within ew (both times the vertex's factor). `inverse` is 1 / W.hi rounded
+/// (any double serves: it only proposes candidates, which are checked), computed once for a
+/// vertex's three coordinates: multiplications instead of two divisions each, whose latency
+/// showed in the rounding loop's profile.
+[[gnu::flatten]] bool round_precise(const DD& X, double ex, const DD& W, double ew, double inverse,
+                                    double& out) {
   if (!(W.hi >= 0x1p-300 && W.hi <= 0x1p300) || !(ew <= 0x1p-60 * W.hi)) return false;
   // The residual R = X - r W in double-double: the product r W.hi is exact (Dekker), and
   // so is the cancelling X.hi - p.hi; what remains is small. `sum` bounds those small
@@ -624,16 +663,17 @@ double step_away(double r, bool away) {
     const double up = step_away(r, r > 0) - r, down = r - step_away(r, r < 0);
     return R + error < 0.5 * up * w_low && R - error > -0.5 * down * w_low;
   };
-  // X.hi / W.hi is within about an ulp of X / W, and often its rounding already: tested
-  // first; otherwise moved by the residual, X / W to about 100 bits, and tested again.
-  const double q1 = X.hi / W.hi;
+  // X.hi / W.hi (as X.hi times the inverse) is within an ulp or two of X / W, and often its
+  // rounding already: tested first; otherwise moved by the residual, X / W to about 100
+  // bits, and tested again.
+  const double q1 = X.hi * inverse;
   if (!(std::abs(q1) >= 0x1p-490 && std::abs(q1) <= 0x1p490)) return false;
   const double R1 = residual(q1);
   if (rounds_to(q1, R1)) {
     out = q1;
     return true;
   }
-  const double r = q1 + R1 / W.hi;
+  const double r = q1 + R1 * inverse;
   if (!(std::abs(r) >= 0x1p-500 && std::abs(r) <= 0x1p500)) return false;
   if (!rounds_to(r, residual(r))) return false;
   out = r;
@@ -642,7 +682,7 @@ double step_away(double r, bool away) {
 
 int det_sign(const Plane& a, const Plane& b, const Plane& c) {
   const int s = interval_sign(det(a.ni, b.ni, c.ni));
-  return s != 2 ? s : CGAL::sign(det(a.n, b.n, c.n));
+  return s != 2 ? s : CGAL::sign(det(*a.n, *b.n, *c.n));
 }
 
 }  // namespace
@@ -711,8 +751,8 @@ bool clockwise(const std::vector<int>& cyc, const std::vector<HVertex>& vertex,
   std::vector<V3<Exact>> exact(n);
   for (int i = 0; i < n; ++i) {
     const HVertex& v = exact_vertex(cyc[i]);
-    const Exact w(v.W);
-    exact[i] = {Exact(v.X.x) / w, Exact(v.X.y) / w, Exact(v.X.z) / w};
+    const Exact w(*v.W);
+    exact[i] = {Exact(v.X->x) / w, Exact(v.X->y) / w, Exact(v.X->z) / w};
   }
   const V3<Exact> nw = newell_normal<Exact>(n, [&](int i) -> const V3<Exact>& { return exact[i]; });
   return CGAL::sign(dot(nw, to_rational(normal))) < 0;
@@ -724,17 +764,41 @@ bool clockwise(const std::vector<int>& cyc, const std::vector<HVertex>& vertex,
 /// cannot decide.
 class VertexExactPoints final : public LazyExactPoints {
  public:
-  /// Vertex r is vertex[order[r]].
-  VertexExactPoints(std::vector<Plane> planes, std::vector<HVertex> vertex, std::vector<int> order)
-      : planes_(std::move(planes)),
+  /// Vertex r is vertex[order[r]]. The polytope outlives the half-spaces and known points
+  /// that `planes` and the vertices point at, unless `owner` keeps them (intersect_halfspaces):
+  /// without it, the planes of the vertices still without exact coordinates are copied with
+  /// their exact values (the others are never read), and so are the known points.
+  VertexExactPoints(const std::vector<Plane>& planes, std::vector<HVertex> vertex,
+                    std::vector<int> order, std::shared_ptr<const void> owner)
+      : planes_(owner ? planes : std::vector<Plane>(planes.size())),
         vertex_(std::move(vertex)),
         order_(std::move(order)),
-        once_(std::make_unique<std::once_flag[]>(order_.size())) {}
+        once_(std::make_unique<std::once_flag[]>(order_.size())),
+        owner_(std::move(owner)) {
+    if (owner_) return;
+    parallel_chunks(static_cast<int>(vertex_.size()), 256, [&](int begin, int end) {
+      for (int i = begin; i < end; ++i) {
+        HVertex& v = vertex_[i];
+        if (v.X && !v.made) set_exact(v, *v.X, *v.W);
+      }
+    });
+    for (const HVertex& v : vertex_) {
+      if (v.X) continue;
+      for (int i : v.planes) {
+        if (planes_[i].n) continue;
+        const Plane& p = planes[i];
+        planes_[i].scaled =
+            p.scaled ? p.scaled : std::make_shared<const ExactPlane>(ExactPlane{*p.n, *p.d});
+        planes_[i].n = &planes_[i].scaled->n;
+        planes_[i].d = &planes_[i].scaled->d;
+      }
+    }
+  }
   void get(int r, const V3<ExactN>*& X, const ExactN*& W) const override {
     HVertex& v = vertex_[order_[r]];
     std::call_once(once_[r], [&] { make_exact(planes_, v); });
-    X = &v.X;
-    W = &v.W;
+    X = v.X;
+    W = v.W;
   }
 
  private:
@@ -742,6 +806,7 @@ class VertexExactPoints final : public LazyExactPoints {
   mutable std::vector<HVertex> vertex_;  // each written once, under its once_flag
   std::vector<int> order_;
   std::unique_ptr<std::once_flag[]> once_;
+  std::shared_ptr<const void> owner_;  // of what planes_ and vertex_ point at, or null
 };
 
 /// The exact points of the intersection's polytope, whose vertex r is vertex[order[r]]
@@ -749,7 +814,8 @@ class VertexExactPoints final : public LazyExactPoints {
 /// coordinates, or, when `eager`, all computed now and without precise coordinates (the
 /// route before, which tests compare with).
 ExactPoints polytope_points(const std::vector<Plane>& planes, std::vector<HVertex>& vertex,
-                            const std::vector<int>& order, bool eager) {
+                            const std::vector<int>& order, bool eager,
+                            std::shared_ptr<const void> owner) {
   const int nv = static_cast<int>(order.size());
   ExactPoints exact;
   if (eager) {
@@ -758,8 +824,8 @@ ExactPoints polytope_points(const std::vector<Plane>& planes, std::vector<HVerte
       for (int r = begin; r < end; ++r) {
         HVertex& v = vertex[order[r]];
         make_exact(planes, v);
-        exact.numerator[r] = v.X;
-        exact.denominator[r] = v.W;
+        exact.numerator[r] = *v.X;
+        exact.denominator[r] = *v.W;
         exact.enclosure[r] = v.xi;
       }
     });
@@ -780,7 +846,8 @@ ExactPoints polytope_points(const std::vector<Plane>& planes, std::vector<HVerte
       p.valid = true;
     }
   }
-  exact.lazy = std::make_shared<VertexExactPoints>(planes, std::move(vertex), order);
+  exact.lazy =
+      std::make_shared<VertexExactPoints>(planes, std::move(vertex), order, std::move(owner));
   return exact;
 }
 
@@ -1083,6 +1150,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
                                             const std::vector<Plane>& planes,
                                             const PrecisePlanes& precise, const KnownPoints& known,
                                             DualSurface s, const IntersectOptions& options,
+                                            const std::shared_ptr<const void>& owner,
                                             bool* repaired = nullptr) {
   const bool with_polytope = options.polytope;
   const int nt = static_cast<int>(s.corner.size());
@@ -1110,22 +1178,46 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   // strictly inside or outside every other one.
   {
     const auto& c0 = s.corner[0];
-    const V3<ExactN> r = planes[c0[0]].n + planes[c0[1]].n + planes[c0[2]].n;
-    // Planes whose normal points away from the ray (<r, n> < 0, by intervals): a triangle of
-    // three such is missed without its determinants (its cone holds no direction of positive
-    // dot with r; one of them would be negative).
-    std::vector<char> away(n);
+    const V3<ExactN> r = *planes[c0[0]].n + *planes[c0[1]].n + *planes[c0[2]].n;
+    // A triangle whose three normals lie strictly on one side of a plane through o that
+    // holds r or leaves it on the other side (<g, n> > 0 for all three, <g, r> <= 0) is
+    // missed without its determinants: its cone holds no such r, so one of them would be
+    // negative. Tested by intervals for g = -r (normals pointing away from the ray) and
+    // for two planes through the ray, g = +-u and +-w with u = e_k x r, w = r x u exactly
+    // orthogonal to r (Mpzf): only the few triangles around the ray are left to test.
+    V3<ExactN> u{ExactN(0), ExactN(0), ExactN(0)};
+    {
+      // e_k the axis of r's smallest component, so that u is far from zero.
+      const double ax = std::abs(r.x.to_double()), ay = std::abs(r.y.to_double()),
+                   az = std::abs(r.z.to_double());
+      if (ax <= ay && ax <= az)
+        u = {ExactN(0), ExactN(0) - r.z, r.y};  // e_x x r
+      else if (ay <= az)
+        u = {r.z, ExactN(0), ExactN(0) - r.x};  // e_y x r
+      else
+        u = {ExactN(0) - r.y, r.x, ExactN(0)};  // e_z x r
+    }
+    const V3<ExactN> w = cross(r, u);
+    // Per plane, bit 0: <r, n> < 0; bits 1, 2: <u, n> > 0, < 0; bits 3, 4: <w, n> > 0, < 0.
+    std::vector<unsigned char> away(n);
     parallel_chunks(n, 1024, [&](int begin, int end) {
       RoundingGuard guard;
-      const V3<Interval> ri = to_interval_n(r);
-      for (int p = begin; p < end; ++p) away[p] = interval_sign(dot(ri, planes[p].ni)) < 0;
+      const V3<Interval> ri = to_interval_n(r), ui = to_interval_n(u), wi = to_interval_n(w);
+      const auto bits = [](int sign, int positive, int negative) {
+        return sign == 1 ? positive : sign == -1 ? negative : 0;
+      };
+      for (int p = begin; p < end; ++p)
+        away[p] = static_cast<unsigned char>(bits(interval_sign(dot(ri, planes[p].ni)), 0, 1) |
+                                             bits(interval_sign(dot(ui, planes[p].ni)), 2, 4) |
+                                             bits(interval_sign(dot(wi, planes[p].ni)), 8, 16));
     });
     std::atomic<int> hits = 0;
     parallel_chunks(nt, 512, [&](int begin, int end) {
       RoundingGuard guard;
-      const Plane ray{r, ExactN(0), to_interval_n(r), Interval(0)};
+      const ExactN zero(0);
+      const Plane ray{&r, &zero, nullptr, to_interval_n(r), Interval(0)};
       for (int t = begin; t < end && ok; ++t) {
-        if (away[s.corner[t][0]] && away[s.corner[t][1]] && away[s.corner[t][2]]) continue;
+        if (away[s.corner[t][0]] & away[s.corner[t][1]] & away[s.corner[t][2]]) continue;
         const Plane &a = planes[s.corner[t][0]], &b = planes[s.corner[t][1]],
                     &c = planes[s.corner[t][2]];
         const int s0 = det_sign(ray, b, c);
@@ -1244,7 +1336,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     s.far_side = std::move(far_side);
     if (!repair_surface(planes, precise, known, s, edges)) return std::nullopt;
     *repaired = true;
-    return build_verified(hs, planes, precise, known, std::move(s), options);
+    return build_verified(hs, planes, precise, known, std::move(s), options, owner);
   }
   std::vector<int> group(nt, -1), seed;
   {
@@ -1310,29 +1402,36 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   for (int t = 0; t < nt; ++t)
     for (int k = 0; k < 3; ++k) some_triangle[s.corner[t][k]] = t;
   // Facet f's cycle of vertices is face_vertex[face_begin[f] .. face_begin[f + 1]).
-  std::vector<int> face_begin(1, 0), face_vertex, face_halfspace;
-  face_vertex.reserve(3 * static_cast<std::size_t>(nt));
+  // The walk around each plane visits the triangles at it once (a closed surface, checked
+  // above): 3 nt entries at most, written by index (push_back was not inlined here).
+  std::vector<int> face_begin(1, 0), face_vertex(3 * static_cast<std::size_t>(nt)), face_halfspace;
+  face_begin.reserve(n + 1);
+  face_halfspace.reserve(n);
+  std::size_t used = 0;
   for (int p = 0; p < n; ++p) {
     if (some_triangle[p] < 0) continue;
-    const std::size_t start = face_vertex.size();
+    const std::size_t start = used;
     int t = some_triangle[p], steps = 0;
     do {
       const int g = group[t];
-      if (face_vertex.size() == start || face_vertex.back() != g) face_vertex.push_back(g);
+      if (used == start || face_vertex[used - 1] != g) {
+        if (used == face_vertex.size()) return std::nullopt;  // (not a closed surface)
+        face_vertex[used++] = g;
+      }
       int k = 0;
       while (k < 3 && s.corner[t][k] != p) ++k;
       if (k == 3 || ++steps > nt) return std::nullopt;
       t = s.across[t][k];
     } while (t != some_triangle[p]);
-    while (face_vertex.size() > start + 1 && face_vertex[start] == face_vertex.back())
-      face_vertex.pop_back();
-    if (face_vertex.size() < start + 3) {
-      face_vertex.resize(start);
+    while (used > start + 1 && face_vertex[start] == face_vertex[used - 1]) --used;
+    if (used < start + 3) {
+      used = start;
       continue;
     }
-    face_begin.push_back(static_cast<int>(face_vertex.size()));
+    face_begin.push_back(static_cast<int>(used));
     face_halfspace.push_back(p);
   }
+  face_vertex.resize(used);
   const int nf = static_cast<int>(face_halfspace.size());
   if (nf < 4) return std::nullopt;
   // Precise vertices, for the checks below (a second filter stage) and the rounding; exact
@@ -1360,7 +1459,9 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
                            precise[x.planes[0]].valid && precise[x.planes[1]].valid &&
                            precise[x.planes[2]].valid;
   }
-  std::vector<V3<DD>> edge_cross(3 * static_cast<std::size_t>(nt));
+  // (Written before read, where from_planes: left uninitialised.)
+  const auto edge_cross =
+      std::make_unique_for_overwrite<V3<DD>[]>(3 * static_cast<std::size_t>(nt));
   const auto shared = [&](int t, int k) {
     const int u = s.across[t][k];
     return from_planes[u] && u < t;
@@ -1535,19 +1636,20 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   {
     std::vector<int> facet_of(n, -1);  // by half-space
     for (int f = 0; f < nf; ++f) facet_of[face_halfspace[f]] = f;
-    std::vector<int> sorted_begin(1, 0), sorted_vertex, sorted_halfspace;
-    sorted_vertex.reserve(face_vertex.size());
+    std::vector<int> sorted_begin(1, 0), sorted_vertex(face_vertex.size()), sorted_halfspace;
+    sorted_begin.reserve(nf + 1);
     sorted_halfspace.reserve(nf);
+    int written = 0;  // (written by index, as face_vertex)
     for (int p = 0; p < n; ++p) {
       const int f = facet_of[p];
       if (f < 0) continue;
-      const auto first = sorted_vertex.end() - sorted_vertex.begin();
+      const int first = written;
       for (int j = face_begin[f]; j < face_begin[f + 1]; ++j)
-        sorted_vertex.push_back(rank[face_vertex[j]]);
+        sorted_vertex[written++] = rank[face_vertex[j]];
       std::rotate(sorted_vertex.begin() + first,
-                  std::min_element(sorted_vertex.begin() + first, sorted_vertex.end()),
-                  sorted_vertex.end());
-      sorted_begin.push_back(static_cast<int>(sorted_vertex.size()));
+                  std::min_element(sorted_vertex.begin() + first, sorted_vertex.begin() + written),
+                  sorted_vertex.begin() + written);
+      sorted_begin.push_back(written);
       sorted_halfspace.push_back(p);
     }
     face_begin = std::move(sorted_begin);
@@ -1575,16 +1677,17 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     for (int r = begin; r < end; ++r) {
       const HVertex& v = vertex[order[r]];
       double rounded[3];
+      const double inverse = v.precise ? 1 / v.pw.hi : 0;
       for (int i = 0; i < 3; ++i) {
         if (v.doubles) {
-          rounded[i] = coordinate(v.X, i).to_double();
+          rounded[i] = coordinate(*v.X, i).to_double();
           continue;
         }
-        if (v.precise &&
-            round_precise(coordinate(v.px, i), coordinate(v.ex, i), v.pw, v.ew, rounded[i]))
+        if (v.precise && round_precise(coordinate(v.px, i), coordinate(v.ex, i), v.pw, v.ew,
+                                       inverse, rounded[i]))
           continue;
         const HVertex& e = exact_vertex(order[r]);
-        rounded[i] = round_quotient(coordinate(e.X, i), e.W, coordinate(v.xi, i));
+        rounded[i] = round_quotient(coordinate(*e.X, i), *e.W, coordinate(v.xi, i));
       }
       rp.points[r] = {rounded[0], rounded[1], rounded[2]};
     }
@@ -1598,7 +1701,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   if (with_polytope) {
     std::vector<V3<ExactN>> normals(nf);
     for (int f = 0; f < nf; ++f) normals[f] = hs[face_halfspace[f]].normal;
-    ExactPoints points = polytope_points(planes, vertex, order, options.eager_exact);
+    ExactPoints points = polytope_points(planes, vertex, order, options.eager_exact, owner);
     Polytope p;
     if (options.direct_polytope) {
       p = verified_polytope(rp.points, std::move(points), face_begin, face_vertex,
@@ -1639,7 +1742,12 @@ class IncrementalHull {
     for (int k = 0; k < 4; ++k) {
       const V3<ExactN> m{ExactN(dirs[k][0]), ExactN(dirs[k][1]), ExactN(dirs[k][2])};
       const ExactN d = dot(m, to_exact_n(o)) + ExactN(reach);
-      virtual_[k] = {m, d, to_interval_n(m), to_interval_n(d)};
+      Plane& v = virtual_[k];
+      v.scaled = std::make_shared<const ExactPlane>(ExactPlane{m, d});
+      v.n = &v.scaled->n;
+      v.d = &v.scaled->d;
+      v.ni = to_interval_n(m);
+      v.di = to_interval_n(d);
     }
   }
 
@@ -1693,11 +1801,7 @@ class IncrementalHull {
           v.precise = true;
         }
         v.precise_tried = tri.precise != -1;
-        if (tri.exact >= 0) {
-          v.X = exact_[tri.exact].X;
-          v.W = exact_[tri.exact].W;
-          v.has_exact = true;
-        }
+        if (tri.exact >= 0) set_exact(v, exact_[tri.exact].X, exact_[tri.exact].W);
       }
       out.has_vertex[index[t]] = 1;
     }
@@ -1752,7 +1856,7 @@ class IncrementalHull {
       const int k = tri.known;
       if (p < n_ && known_.passes(p, k)) return 0;
       const int s = interval_sign(dot(h.ni, known_.Xi[k]) - h.di * known_.Wi[k]);
-      return s != 2 ? s : CGAL::sign(dot(h.n, known_.X[k]) - h.d * known_.W[k]);
+      return s != 2 ? s : CGAL::sign(dot(*h.n, known_.X[k]) - *h.d * known_.W[k]);
     }
     const int s = interval_sign(dot(h.ni, tri.Xi) - h.di * tri.Wi);
     if (s != 2) return s;
@@ -1780,11 +1884,11 @@ class IncrementalHull {
     if (tri.exact < 0) {
       const Plane &a = plane(tri.c[0]), &b = plane(tri.c[1]), &c = plane(tri.c[2]);
       ExactVertex& v = exact_.emplace_back();
-      meet(a.n, a.d, b.n, b.d, c.n, c.d, v.X, v.W);
+      meet(*a.n, *a.d, *b.n, *b.d, *c.n, *c.d, v.X, v.W);
       tri.exact = static_cast<int>(exact_.size()) - 1;
     }
     const ExactVertex& v = exact_[tri.exact];
-    return CGAL::sign(dot(h.n, v.X) - h.d * v.W);
+    return CGAL::sign(dot(*h.n, v.X) - *h.d * v.W);
   }
 
   void see(int p, int t) {
@@ -1926,8 +2030,8 @@ class IncrementalHull {
 double first_reach(const std::vector<Plane>& planes, const V3<double>& o) {
   double r = 0;
   for (const Plane& p : planes) {
-    const V3<double> n{p.n.x.to_double(), p.n.y.to_double(), p.n.z.to_double()};
-    const double dist = (p.d.to_double() - dot(n, o)) / std::sqrt(dot(n, n));
+    const V3<double> n{p.n->x.to_double(), p.n->y.to_double(), p.n->z.to_double()};
+    const double dist = (p.d->to_double() - dot(n, o)) / std::sqrt(dot(n, n));
     if (std::isfinite(dist)) r = std::max(r, dist);
   }
   return std::ldexp(1.0, std::ilogb(std::max(r, 1e-300)) + 4);
@@ -1949,8 +2053,8 @@ DualSurface exact_dual_hull(const std::vector<Plane>& planes, const V3<Exact>& o
   std::map<Point, int> index_of;
   for (int i = 0; i < n; ++i) {
     const Plane& h = planes[i];
-    const ExactN w = qn * h.d - dot(h.n, p);
-    points[i] = Point(FT(Q(qn * h.n.x, w)), FT(Q(qn * h.n.y, w)), FT(Q(qn * h.n.z, w)));
+    const ExactN w = qn * *h.d - dot(*h.n, p);
+    points[i] = Point(FT(Q(qn * h.n->x, w)), FT(Q(qn * h.n->y, w)), FT(Q(qn * h.n->z, w)));
     index_of.emplace(points[i], i);
   }
   CGAL::Surface_mesh<Point> hull;
@@ -1964,13 +2068,14 @@ namespace {
 
 void probe_rounding(const HVertex& v, PreciseProbe& out) {
   if (v.doubles) {
-    out.rounded = {v.X.x.to_double(), v.X.y.to_double(), v.X.z.to_double()};
+    out.rounded = {v.X->x.to_double(), v.X->y.to_double(), v.X->z.to_double()};
     out.decided = {true, true, true};
   }
   if (!v.precise) return;
-  out.decided = {round_precise(v.px.x, v.ex.x, v.pw, v.ew, out.rounded.x),
-                 round_precise(v.px.y, v.ex.y, v.pw, v.ew, out.rounded.y),
-                 round_precise(v.px.z, v.ex.z, v.pw, v.ew, out.rounded.z)};
+  const double inverse = 1 / v.pw.hi;
+  out.decided = {round_precise(v.px.x, v.ex.x, v.pw, v.ew, inverse, out.rounded.x),
+                 round_precise(v.px.y, v.ex.y, v.pw, v.ew, inverse, out.rounded.y),
+                 round_precise(v.px.z, v.ex.z, v.pw, v.ew, inverse, out.rounded.z)};
 }
 
 }  // namespace
@@ -1999,9 +2104,8 @@ PreciseProbe probe_precise_point(const V3<ExactN>& X, const ExactN& W) {
   PreciseProbe out;
   HVertex v;
   v.known = 0;
-  v.X = X;
-  v.W = W;
-  v.has_exact = true;
+  v.X = &X;
+  v.W = &W;
   const std::vector<Plane> none;
   make_precise(PrecisePlanes(none), v);
   probe_rounding(v, out);
@@ -2163,8 +2267,11 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
   const auto compute_vertex = [&](int t) {
     ready[t] = 1;
     const auto [i, j, l] = triangle[t];
-    HVertex& v = vertex[t];  // fresh, or a flipped triangle's: drop what that one had
-    v.has_exact = false;
+    // Fresh, or a flipped triangle's: drop what that one had (a `made` is freed when the
+    // vertex is made exact again, or goes).
+    HVertex& v = vertex[t];
+    v.X = nullptr;
+    v.W = nullptr;
     v.known = -1;
     v.precise = v.precise_tried = false;
     v.planes = {p[i], p[j], p[l]};
@@ -2317,7 +2424,8 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const PrecisePlan
 
 MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<double>& hint,
                                    const IntersectOptions& options, const KnownPoints& known,
-                                   const ExpectedVertices& expected) {
+                                   const ExpectedVertices& expected,
+                                   std::shared_ptr<const void> owner) {
   MaybePolytope out;
   const std::vector<Plane> planes = planes_of(hs);
   V3<Exact> o = to_exact(hint);
@@ -2346,7 +2454,7 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
     bool repaired = false;
     if (auto built = build_verified(hs, planes, precise, known,
                                     expected_surface(planes, precise, known, expected), options,
-                                    &repaired)) {
+                                    owner, &repaired)) {
       built->route = repaired ? HullRoute::repaired : HullRoute::expected;
       return std::move(*built);
     }
@@ -2358,7 +2466,7 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
       const auto outcome = IncrementalHull(planes, precise, known, o_double, reach).run(s);
       if (outcome == IncrementalHull::Outcome::too_small) continue;
       if (outcome == IncrementalHull::Outcome::hull) {
-        if (auto built = build_verified(hs, planes, precise, known, std::move(s), options)) {
+        if (auto built = build_verified(hs, planes, precise, known, std::move(s), options, owner)) {
           built->route = HullRoute::incremental;
           return std::move(*built);
         }
@@ -2366,12 +2474,12 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
       break;
     }
   }
-  auto built = build_verified(hs, planes, precise, known, exact_dual_hull(planes, o), options);
+  auto built =
+      build_verified(hs, planes, precise, known, exact_dual_hull(planes, o), options, owner);
   if (!built) throw error("internal error: the exact dual hull of an erosion failed its own check");
   built->route = HullRoute::exact;
   return std::move(*built);
 }
-
 
 bool round_precise_sum(const DD& X, double error, const DD& W, double w_error, double b,
                        double& out) {
@@ -2385,7 +2493,7 @@ bool round_precise_sum(const DD& X, double error, const DD& W, double w_error, d
   // 4 u^2 of the magnitude of its operands (|b| |W|, then |X| + |b W|), taken as 16 u^2.
   const double magnitude = std::abs(X.hi) + std::abs(b) * W.hi;
   const double bound = (error + std::abs(b) * w_error + 16 * kU2 * magnitude) * 1.01 + 0x1p-1000;
-  return round_precise(sum, bound, W, w_error, out);
+  return round_precise(sum, bound, W, w_error, 1 / W.hi, out);
 }
 
 }  // namespace morph::detail

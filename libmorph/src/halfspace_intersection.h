@@ -6,6 +6,7 @@
 #include <morph/morphology.h>
 
 #include <array>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -143,11 +144,14 @@ struct ExpectedVertices {
 /// whichever route computed it. Expected O(n log n) for n half-spaces (exact arithmetic
 /// only where interval filters cannot decide).
 /// `known`: points known to lie on the planes; `expected`: a guess of the result (both
-/// optional: the result is the same, only faster).
+/// optional: the result is the same, only faster). `owner`, when given, owns `halfspaces`
+/// and `known` (unchanged while it lives): the polytope's lazy exact points then keep it
+/// and read their exact planes and known points there; otherwise they copy what they need.
 MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& halfspaces, const V3<double>& hint,
                                    const IntersectOptions& options = {},
                                    const KnownPoints& known = {},
-                                   const ExpectedVertices& expected = {});
+                                   const ExpectedVertices& expected = {},
+                                   std::shared_ptr<const void> owner = nullptr);
 
 /// For tests: the precise (double-double) stage of the intersection's vertices alone.
 /// `rounded` holds the coordinates of a vertex rounded to nearest where that stage decides
