@@ -473,15 +473,26 @@ class PrecisePlanes {
   // Each plane's state: not made, being made (by the thread that claimed it), made. A flag
   // of our own: std::call_once costs more than most of the copies it guards.
   static constexpr unsigned char kNone = 0, kMaking = 1, kMade = 2;
+  // A claim whose making throws (out of memory) is given back before the exception leaves:
+  // a thread waiting for the plane then claims it in turn (and makes it, or meets the error
+  // itself) instead of waiting forever for a copy nobody is making.
   [[gnu::noinline]] void make(int i) const {  // (keeps operator[] small enough to inline)
-    unsigned char expected = kNone;
-    if (state_[i].compare_exchange_strong(expected, kMaking, std::memory_order_acquire)) {
-      CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
-      precise_[i] = precise_plane(planes_[i]);
-      state_[i].store(kMade, std::memory_order_release);
-      return;
+    for (;;) {
+      unsigned char expected = kNone;
+      if (state_[i].compare_exchange_strong(expected, kMaking, std::memory_order_acquire)) {
+        try {
+          CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+          precise_[i] = precise_plane(planes_[i]);
+        } catch (...) {
+          state_[i].store(kNone, std::memory_order_release);
+          throw;
+        }
+        state_[i].store(kMade, std::memory_order_release);
+        return;
+      }
+      if (expected == kMade) return;  // the failed exchange read it (with acquire order)
+      std::this_thread::yield();
     }
-    while (state_[i].load(std::memory_order_acquire) != kMade) std::this_thread::yield();
   }
 
   const std::vector<Plane>& planes_;
