@@ -180,14 +180,15 @@ bool strictly_inside(const std::vector<Plane>& planes, const V3<double>& o) {
   return inside;
 }
 
-/// A vertex of the intersection in homogeneous coordinates: X / W with W > 0, the meet
-/// of three of the planes. The exact coordinates are computed only where the filters
-/// (intervals, then double-double) cannot decide, or for a polytope chained further.
 /// Exact homogeneous coordinates of a vertex.
 struct ExactCoordinates {
   V3<ExactN> X;
   ExactN W;
 };
+
+/// A vertex of the intersection in homogeneous coordinates: X / W with W > 0, the meet
+/// of three of the planes. The exact coordinates are computed only where the filters
+/// (intervals, then double-double) cannot decide, or for a polytope chained further.
 struct HVertex {
   std::array<int, 3> planes;
   V3<Interval> Xi;

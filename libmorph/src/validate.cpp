@@ -438,6 +438,16 @@ struct PlaneHeight {
   }
 };
 
+// Six times the volume of the tetrahedron (o, a, b, c): FanVolumes::add_face()'s
+// dot(a - o, cross(b - o, c - o)), in OpenMesh's order of operations.
+inline double six_volume(const Point& o, const Point& a, const Point& b, const Point& c) {
+  const double u[3] = {a[0] - o[0], a[1] - o[1], a[2] - o[2]};
+  const double v[3] = {b[0] - o[0], b[1] - o[1], b[2] - o[2]};
+  const double w[3] = {c[0] - o[0], c[1] - o[1], c[2] - o[2]};
+  return (u[0] * (v[1] * w[2] - v[2] * w[1]) + u[1] * (v[2] * w[0] - v[0] * w[2])) +
+         u[2] * (v[0] * w[1] - v[1] * w[0]);
+}
+
 // A triangle's share of nondegenerate(), the usual case: the same operations in the same
 // order as newell_plane(), height(), FanVolumes::add_face() and reflex_across(), unrolled
 // into one place (the general path's loops and calls cost more than its arithmetic), so
@@ -446,7 +456,6 @@ struct PlaneHeight {
 // when the triangle fails one of the checks that reject a mesh: the general path then
 // names the problem.
 SmallPlane triangle_plane(const MeshView& m, const int* ids, const Point& centre, bool unit) {
-  SmallPlane q;
   const int i0 = ids[0], i1 = ids[1], i2 = ids[2];
   // A repeated vertex or position needs no test of its own here: with two equal corners,
   // two of the cross products below are opposites and the third is zero (a x a), so the
@@ -466,28 +475,14 @@ SmallPlane triangle_plane(const MeshView& m, const int* ids, const Point& centre
   const double nx = ((0.0 + (ay * bz - az * by)) + (by * qz - bz * qy)) + (qy * az - qz * ay);
   const double ny = ((0.0 + (az * bx - ax * bz)) + (bz * qx - bx * qz)) + (qz * ax - qx * az);
   const double nz = ((0.0 + (ax * by - ay * bx)) + (bx * qy - by * qx)) + (qx * ay - qy * ax);
-  q.length2 = (nx * nx + ny * ny) + nz * nz;
+  double magnitude = 0;
   if (unit) {
     const double la = norm1(ax, ay, az), lb = norm1(bx, by, bz), lq = norm1(qx, qy, qz);
-    q.magnitude = (la * lb + lb * lq) + lq * la;
+    magnitude = (la * lb + lb * lq) + lq * la;
   }
-  q.cx = cx;
-  q.cy = cy;
-  q.cz = cz;
-  q.nx = nx;
-  q.ny = ny;
-  q.nz = nz;
-  q.degree = 3;
   // FanVolumes::add_face(): the one tetrahedron (q, a, b) of the fan from the last corner.
-  const Point& o = centre;
-  const double u[3] = {p2[0] - o[0], p2[1] - o[1], p2[2] - o[2]};
-  const double v[3] = {p0[0] - o[0], p0[1] - o[1], p0[2] - o[2]};
-  const double w[3] = {p1[0] - o[0], p1[1] - o[1], p1[2] - o[2]};
-  q.first = (u[0] * (v[1] * w[2] - v[2] * w[1]) + u[1] * (v[2] * w[0] - v[0] * w[2])) +
-            u[2] * (v[0] * w[1] - v[1] * w[0]);
-  q.second = 0;
-  q.ok = true;
-  return q;
+  const double volume = six_volume(centre, p2, p0, p1), length2 = (nx * nx + ny * ny) + nz * nz;
+  return {cx, cy, cz, nx, ny, nz, volume, 0, length2, magnitude, 3, true};
 }
 
 bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, const SmallPlane& q,
@@ -597,31 +592,16 @@ SmallPlane quad_plane(const MeshView& m, const int* ids, const Point& centre, bo
                     (rz * ax - rx * az);
   const double nz = (((0.0 + (ax * by - ay * bx)) + (bx * qy - by * qx)) + (qx * ry - qy * rx)) +
                     (rx * ay - ry * ax);
-  q.length2 = (nx * nx + ny * ny) + nz * nz;
+  double magnitude = 0;
   if (unit) {
     const double la = norm1(ax, ay, az), lb = norm1(bx, by, bz), lq = norm1(qx, qy, qz),
                  lr = norm1(rx, ry, rz);
-    q.magnitude = ((la * lb + lb * lq) + lq * lr) + lr * la;
+    magnitude = ((la * lb + lb * lq) + lq * lr) + lr * la;
   }
-  q.cx = cx;
-  q.cy = cy;
-  q.cz = cz;
-  q.nx = nx;
-  q.ny = ny;
-  q.nz = nz;
-  q.degree = 4;
   // FanVolumes::add_face(): the fan from the last corner, tetrahedra (r, a, b), (r, b, q).
-  const Point& o = centre;
-  const double u[3] = {p3[0] - o[0], p3[1] - o[1], p3[2] - o[2]};
-  const double v[3] = {p0[0] - o[0], p0[1] - o[1], p0[2] - o[2]};
-  const double w[3] = {p1[0] - o[0], p1[1] - o[1], p1[2] - o[2]};
-  const double t[3] = {p2[0] - o[0], p2[1] - o[1], p2[2] - o[2]};
-  q.first = (u[0] * (v[1] * w[2] - v[2] * w[1]) + u[1] * (v[2] * w[0] - v[0] * w[2])) +
-            u[2] * (v[0] * w[1] - v[1] * w[0]);
-  q.second = (u[0] * (w[1] * t[2] - w[2] * t[1]) + u[1] * (w[2] * t[0] - w[0] * t[2])) +
-             u[2] * (w[0] * t[1] - w[1] * t[0]);
-  q.ok = true;
-  return q;
+  const double first = six_volume(centre, p3, p0, p1), second = six_volume(centre, p3, p1, p2);
+  const double length2 = (nx * nx + ny * ny) + nz * nz;
+  return {cx, cy, cz, nx, ny, nz, first, second, length2, magnitude, 4, true};
 }
 
 bool quad_passes(const MeshView& m, const FaceCycles& cycles, int f, const SmallPlane& q,
