@@ -18,6 +18,9 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/convex_hull_3.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 #include <morph/error.h>
 
 #include <algorithm>
@@ -136,13 +139,26 @@ std::optional<Connectivity> connect(int num_points, const Soup& soup) {
   Connectivity k = facet_cycles(soup);
   k.twin = Ints(nc);  // each corner's twin is set below (each is the prev of one corner)
   k.first_out = Ints(num_points);
-  // Outgoing corners of each vertex (counting sort).
+  // Outgoing corners of each vertex (counting sort), each with what its vertex's fan reads
+  // of it: the point its edge goes to, and the corner before it (whose edge ends at the
+  // vertex) with that corner's point. Read here in corner order, near each other, rather
+  // than by chains of loads from the sorted corners in the fans below.
+  struct Out {
+    int corner, to, before, from;
+  };
   std::vector<int>& out_begin = k.out_begin;
   out_begin.assign(num_points + 1, 0);
-  Ints out(nc);
-  for (int c = 0; c < nc; ++c) ++out_begin[soup.vertex[c]];
-  std::partial_sum(out_begin.begin(), out_begin.end(), out_begin.begin());  // ends, until filled
-  for (int c = nc - 1; c >= 0; --c) out[--out_begin[soup.vertex[c]]] = c;
+  const auto out = std::make_unique_for_overwrite<Out[]>(nc);
+  {
+    const int *vertex = soup.vertex.data(), *next = k.next.data(), *prev = k.prev.data();
+    int* const end = out_begin.data();
+    for (int c = 0; c < nc; ++c) ++end[vertex[c]];
+    std::partial_sum(end, end + num_points + 1, end);  // ends, until filled
+    for (int c = nc - 1; c >= 0; --c) {
+      const int d = prev[c];
+      out[--end[vertex[c]]] = {c, vertex[next[c]], d, vertex[d]};
+    }
+  }
   // By place in `out`: the place of the next edge leaving the same vertex around it.
   Ints turn(nc);
   // Vertices are independent (each writes the twins of the edges ending at it): in parallel.
@@ -153,26 +169,27 @@ std::optional<Connectivity> connect(int num_points, const Soup& soup) {
     // among them).
     std::vector<int> edge_to(num_points, -1);
     // Plain pointers: the writes through them could alias the captured arrays' own pointers.
-    const int *vertex = soup.vertex.data(), *next = k.next.data(), *prev = k.prev.data();
-    const int* order = out.data();
+    const Out* const order = out.get();
     int *twin = k.twin.data(), *place = turn.data(), *mark = edge_to.data();
+    int* const first_out = k.first_out.data();
+    const int* const begin = out_begin.data();
     const auto fan = [&](int v) {
-      const int b = out_begin[v], n = out_begin[v + 1] - b;
-      k.first_out[v] = n > 0 ? order[b] : -1;
+      const int b = begin[v], n = begin[v + 1] - b;
+      const Out* const o = order + b;
+      first_out[v] = n > 0 ? o[0].corner : -1;
       if (n == 0) return true;
       for (int i = 0; i < n; ++i) {
-        int& e = mark[vertex[next[order[b + i]]]];
+        int& e = mark[o[i].to];
         if (e >= 0) return false;  // v -> w twice
         e = i;
       }
       for (int i = 0; i < n; ++i) {
-        const int d = prev[order[b + i]];
-        const int t = mark[vertex[d]];
+        const int t = mark[o[i].from];
         if (t < 0) return false;  // u -> v has no opposite edge
-        twin[d] = order[b + t];
+        twin[o[i].before] = o[t].corner;
         place[b + i] = t;  // twin[prev[out[b + i]]] is out[b + t]
       }
-      for (int i = 0; i < n; ++i) mark[vertex[next[order[b + i]]]] = -1;
+      for (int i = 0; i < n; ++i) mark[o[i].to] = -1;
       // One fan per vertex: turning from an outgoing edge to the next (over the twin of the
       // edge before it) reaches them all.
       int i = 0, steps = 0;
@@ -198,6 +215,17 @@ struct FacetGeometry {
   double longest_edge;
 };
 
+/// Two doubles operated on lane by lane (GCC and Clang vector extensions).
+using Pair = double __attribute__((vector_size(16)));
+
+Pair pair_sqrt(Pair x) {
+#if defined(__SSE2__)
+  return _mm_sqrt_pd(x);
+#else
+  return Pair{std::sqrt(x[0]), std::sqrt(x[1])};
+#endif
+}
+
 FacetGeometry geometry(const std::vector<V3<double>>& points, const Soup& soup, int f) {
   FacetGeometry g{};  // zeros
   const int b = soup.begin[f], d = soup.degree(f);
@@ -213,15 +241,26 @@ FacetGeometry geometry(const std::vector<V3<double>>& points, const Soup& soup, 
     centroid = centroid + p;
     p = q;
   }
-  g.longest_edge = std::sqrt(longest_squared);
-  if (d == 4)  // x * 0.25 is x / 4 (both exact or both the same rounding), and cheaper
-    centroid = {origin.x + centroid.x * 0.25, origin.y + centroid.y * 0.25,
-                origin.z + centroid.z * 0.25};
-  else
-    centroid = {origin.x + centroid.x / d, origin.y + centroid.y / d, origin.z + centroid.z / d};
-  g.twice_area = std::sqrt(dot(sum, sum));
+  // Both roots in one instruction and the six divisions in three, two lanes at a time: a
+  // lane of a packed root or quotient is the scalar one (IEEE), and the unit that does them
+  // takes as long for two lanes as for one (they were most of this function's time).
+  const Pair roots = pair_sqrt(Pair{longest_squared, dot(sum, sum)});
+  g.longest_edge = roots[0];
+  g.twice_area = roots[1];
   if (g.twice_area > 0) {
-    g.normal = {sum.x / g.twice_area, sum.y / g.twice_area, sum.z / g.twice_area};
+    const double area = g.twice_area;
+    const Pair xy = Pair{sum.x, sum.y} / Pair{area, area};
+    if (d == 4) {  // x * 0.25 is x / 4 (both exact or both the same rounding), and cheaper
+      g.normal = {xy[0], xy[1], sum.z / area};
+      centroid = {origin.x + centroid.x * 0.25, origin.y + centroid.y * 0.25,
+                  origin.z + centroid.z * 0.25};
+    } else {
+      const double n = d;
+      const Pair zx = Pair{sum.z, centroid.x} / Pair{area, n};
+      const Pair yz = Pair{centroid.y, centroid.z} / Pair{n, n};
+      g.normal = {xy[0], xy[1], zx[0]};
+      centroid = {origin.x + zx[1], origin.y + yz[0], origin.z + yz[1]};
+    }
     g.offset = dot(g.normal, centroid);
   }
   return g;
@@ -794,35 +833,53 @@ Mesh build_serial(const std::vector<V3<double>>& points, const Soup& soup, const
   mesh.resize(num_used, num_edges, soup.size());
   // The point array, looked up once (set_point looks its property up by a dynamic_cast).
   Point* point = mesh.property(mesh.points_pph()).data_vector().data();
-  for (int v = 0; v < np; ++v)
-    if (handle[v] >= 0) point[handle[v]] = Point(points[v].x, points[v].y, points[v].z);
-  const auto vh = [&](int c) { return Mesh::VertexHandle(handle[soup.vertex[c]]); };
+  // Every point used (a sum's points are its facets' corners, so unless facets merge or
+  // collapse): each point's mesh vertex is its index, and no lookup is needed per corner.
+  const bool all_used = num_used == np;
+  if (all_used)
+    for (int v = 0; v < np; ++v) point[v] = Point(points[v].x, points[v].y, points[v].z);
+  else
+    for (int v = 0; v < np; ++v)
+      if (handle[v] >= 0) point[handle[v]] = Point(points[v].x, points[v].y, points[v].z);
   Ints halfedge(nc);  // of each corner
-  const auto he = [&](int c) { return Mesh::HalfedgeHandle(halfedge[c]); };
+  // Plain pointers: the mesh's writes could alias the vectors' own pointers, which would
+  // then be loaded again for each corner.
+  const int *const vertex = soup.vertex.data(), *const twin = k.twin.data(),
+                   *const next = k.next.data(), *const begin = soup.begin.data();
+  int* const corner_halfedge = halfedge.data();
+  const int nf = soup.size();
   // One pass, face by face (the corners in order): a face's halfedges are all known after
-  // its own corners, as the twins of earlier corners or new edges.
-  int edge = 0;
-  for (int f = 0; f < soup.size(); ++f) {
-    const int b = soup.begin[f], e = soup.begin[f + 1];
-    for (int c = b; c < e; ++c) {
-      const int t = k.twin[c];
-      if (t < c) {
-        halfedge[c] = mesh.opposite_halfedge_handle(he(t)).idx();
-      } else {
-        halfedge[c] = mesh.halfedge_handle(Mesh::EdgeHandle(edge++), 0).idx();
-        mesh.set_vertex_handle(he(c), vh(k.next[c]));
-        mesh.set_vertex_handle(mesh.opposite_halfedge_handle(he(c)), vh(c));
+  // its own corners, as the twins of earlier corners or new edges. `vh`: the mesh vertex
+  // of a corner's point.
+  const auto fill = [&](const auto& vh) {
+    const auto he = [&](int c) { return Mesh::HalfedgeHandle(corner_halfedge[c]); };
+    int edge = 0;
+    for (int f = 0; f < nf; ++f) {
+      const int b = begin[f], e = begin[f + 1];
+      for (int c = b; c < e; ++c) {
+        const int t = twin[c];
+        if (t < c) {
+          corner_halfedge[c] = mesh.opposite_halfedge_handle(he(t)).idx();
+        } else {
+          corner_halfedge[c] = mesh.halfedge_handle(Mesh::EdgeHandle(edge++), 0).idx();
+          mesh.set_vertex_handle(he(c), vh(next[c]));
+          mesh.set_vertex_handle(mesh.opposite_halfedge_handle(he(c)), vh(c));
+        }
+        // A vertex's halfedge is its last corner's (as when faces are added in order).
+        mesh.set_halfedge_handle(vh(c), he(c));
       }
-      // A vertex's halfedge is its last corner's (as when faces are added in order).
-      mesh.set_halfedge_handle(vh(c), he(c));
+      const Mesh::FaceHandle fh(f);
+      for (int c = b; c < e; ++c) {
+        mesh.set_face_handle(he(c), fh);
+        mesh.set_next_halfedge_handle(he(c), he(next[c]));
+      }
+      mesh.set_halfedge_handle(fh, he(e - 1));  // as add_face: the cycle starts at vertex b
     }
-    const Mesh::FaceHandle fh(f);
-    for (int c = b; c < e; ++c) {
-      mesh.set_face_handle(he(c), fh);
-      mesh.set_next_halfedge_handle(he(c), he(k.next[c]));
-    }
-    mesh.set_halfedge_handle(fh, he(e - 1));  // as add_face: the cycle starts at vertex b
-  }
+  };
+  if (all_used)
+    fill([&](int c) { return Mesh::VertexHandle(vertex[c]); });
+  else
+    fill([&](int c) { return Mesh::VertexHandle(handle[vertex[c]]); });
   return mesh;
 }
 
