@@ -525,3 +525,39 @@ TEST_CASE("clean_mesh tests the corners of merged polygons only") {
 }
 
 }  // namespace
+
+// index_vertices with one thread finds the distinct pairs in lists at the vertices of the
+// operand with more vertices: either operand, lists of several pairs, pairs found out of
+// order. The pairs must come out sorted, each once, and each corner must name its own.
+TEST_CASE("index_vertices numbers the distinct pairs in order, listed by either operand") {
+  for (const bool more_b : {false, true}) {
+    const int num_a = more_b ? 5 : 40, num_b = more_b ? 40 : 5;
+    morph::detail::SumFacets facets;
+    std::set<std::uint64_t> expected;
+    unsigned state = 12345;
+    const auto next = [&](int n) {
+      state = state * 1103515245u + 12345u;
+      return static_cast<int>((state >> 8) % static_cast<unsigned>(n));
+    };
+    for (int f = 0; f < 300; ++f) {  // triangles over random pairs, repeats and all
+      for (int k = 0; k < 3; ++k) {
+        const std::uint64_t key = morph::detail::pair_key(next(num_a), next(num_b));
+        facets.corners.push_back(key);
+        expected.insert(key);
+      }
+      facets.face_begin.push_back(static_cast<int>(facets.corners.size()));
+    }
+    std::vector<std::uint64_t> pairs;
+    std::vector<int> corners;
+    morph::detail::run_with_threads(1, [&] {
+      morph::detail::index_vertices(facets, num_a, num_b, pairs, corners);
+    });
+    CHECK(pairs == std::vector<std::uint64_t>(expected.begin(), expected.end()));
+    REQUIRE(corners.size() == facets.corners.size());
+    int wrong = 0;
+    for (std::size_t c = 0; c < corners.size(); ++c)
+      wrong += corners[c] < 0 || corners[c] >= static_cast<int>(pairs.size()) ||
+               pairs[corners[c]] != facets.corners[c];
+    CHECK(wrong == 0);
+  }
+}

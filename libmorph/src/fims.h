@@ -31,8 +31,10 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B);
 
 /// The vertices of A (+) B as its facets use them: the distinct pairs (i, j), sorted, and
 /// each corner's index among them (sum_mesh and sum_polytope number S's vertices so).
-/// Linear in the number of corners: a counting sort buckets the corners by their vertex of
-/// A, and in each bucket only the few distinct partners in B are sorted.
+/// Linear in the number of corners: with one thread, each corner's pair is looked up among
+/// the few found so far at its vertex of the operand with more vertices, and the pairs are
+/// then counting-sorted; with threads, a counting sort buckets the corners by their vertex
+/// of A, and in each bucket only the few distinct partners in B are sorted.
 void index_vertices(const SumFacets& facets, int num_a, int num_b,
                     std::vector<std::uint64_t>& pairs, std::vector<int>& corners);
 
