@@ -165,8 +165,9 @@ std::optional<Connectivity> connect(int num_points, const Soup& soup) {
   std::atomic<bool> manifold{true};
   parallel_chunks(num_points, kVertexGrain, [&](int first, int last) {
     // Each corner d ending at v (u -> v) precedes one leaving v; its twin is the edge
-    // v -> u, looked up by its end while the edges leaving v are marked (by their place
-    // among them).
+    // v -> u, looked up by its end while the edges leaving v are marked (by their place in
+    // `out`: the vertices come in order, so a mark below v's first place is an earlier
+    // vertex's, and none needs clearing).
     std::vector<int> edge_to(num_points, -1);
     // Plain pointers: the writes through them could alias the captured arrays' own pointers.
     const Out* const order = out.get();
@@ -180,16 +181,15 @@ std::optional<Connectivity> connect(int num_points, const Soup& soup) {
       if (n == 0) return true;
       for (int i = 0; i < n; ++i) {
         int& e = mark[o[i].to];
-        if (e >= 0) return false;  // v -> w twice
-        e = i;
+        if (e >= b) return false;  // v -> w twice
+        e = b + i;
       }
       for (int i = 0; i < n; ++i) {
-        const int t = mark[o[i].from];
+        const int t = mark[o[i].from] - b;
         if (t < 0) return false;  // u -> v has no opposite edge
         twin[o[i].before] = o[t].corner;
         place[b + i] = t;  // twin[prev[out[b + i]]] is out[b + t]
       }
-      for (int i = 0; i < n; ++i) mark[o[i].to] = -1;
       // One fan per vertex: turning from an outgoing edge to the next (over the twin of the
       // edge before it) reaches them all.
       int i = 0, steps = 0;
