@@ -297,6 +297,68 @@ TEST_CASE("normal predicates: locate with a SlotCache answers as with slot_plane
   }
 }
 
+// A region's cap (RegionCap) stands in for its region test: every direction in it must be
+// inside the region by exact evaluation, on every slot. Checked on the facet normals of
+// nearly degenerate pairs (the finer sphere's normals within 1e-16 of the coarser's region
+// corners, a copy turned by 1e-12, scaled far from unit size) and of the pair whose walks use
+// caps in the kernel (uvsphere_1600 on the snub dodecahedron's map); the caps' radii must
+// stay below each slot's great circle's distance from the centre, and walks with caps must
+// answer as without.
+TEST_CASE("normal predicates: a region's cap holds only directions inside the region") {
+  using morph::detail::Location;
+  std::vector<std::pair<Mesh, Mesh>> pairs = slot_test_pairs();
+  pairs.emplace_back(sample("uvsphere_1600.off"), sample("snub_dodecahedron.off"));
+  pairs.emplace_back(sample("icosphere_1280.off"), sample("icosphere_320.off"));
+  int total_in_caps = 0;
+  for (const auto& [a, b] : pairs) {
+    const Polytope A = morph::detail::make_operand(a, "A");
+    const Polytope B = morph::detail::make_operand(b, "B");
+    const auto slots = morph::detail::slot_planes(B);
+    morph::detail::SlotCache cache(B, true);
+    REQUIRE(cache.has_caps());
+    int capped = 0, in_caps = 0, outside = 0, wide = 0, differing = 0;
+    for (int v = 0; v < B.num_vertices(); ++v) {
+      const morph::detail::RegionCap cap = morph::detail::region_cap(B, slots.data(), v);
+      if (cap.threshold > 1) continue;
+      ++capped;
+      const int begin = B.fan_begin[v], d = B.fan_begin[v + 1] - begin;
+      const double radius = std::acos(cap.threshold);
+      for (int s = begin; s < begin + d; ++s) {
+        const auto& p = slots[s];
+        const double size = std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z);
+        wide += std::asin((cap.x * p.x + cap.y * p.y + cap.z * p.z) / size) <= radius;
+      }
+      for (int f = 0; f < A.num_faces(); ++f) {
+        if (!morph::detail::in_cap(cap, A.unit_normals[f])) continue;
+        ++in_caps;
+        const NormalRef n{&A, f};
+        for (int i = 0; i < d; ++i) {
+          const NormalRef l{&B, B.fan_face[begin + i]}, r{&B, B.fan_face[begin + (i + 1) % d]};
+          outside += CGAL::sign(morph::detail::det(l.exact(), r.exact(), n.exact())) <= 0;
+        }
+      }
+    }
+    int hint = 0;
+    for (int f = 0; f < A.num_faces(); ++f) {
+      const NormalRef n{&A, f};
+      for (const int start : {0, hint}) {
+        const Location want = morph::detail::locate(B, slots.data(), n, start);
+        for (const bool step : {true, false}) {
+          const Location got = morph::detail::locate(B, cache, n, start, step);
+          differing += got.kind != want.kind || got.index != want.index;
+        }
+      }
+      hint = morph::detail::location_vertex(B, morph::detail::locate(B, cache, n, hint));
+    }
+    CHECK(capped > 0);
+    CHECK(outside == 0);
+    CHECK(wide == 0);
+    CHECK(differing == 0);
+    total_in_caps += in_caps;
+  }
+  CHECK(total_in_caps > 1000);
+}
+
 // same_normal (gauss_map.h) spares the later stages the predicates on exactly coincident
 // normals (A (+) A, A (+) -A, A (+) an exact translate or a copy scaled by a power of two):
 // it must claim equal directions only where they are exactly equal (not for a copy scaled by

@@ -2,6 +2,7 @@
 
 #include <morph/error.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -12,6 +13,9 @@
 namespace morph::detail {
 
 namespace {
+
+/// The narrowest cap (its angular radius) worth testing (RegionCap).
+constexpr double kMinCapAngle = 1e-3;
 
 /// X lies on the closed arc (p, q), given that it lies on the great circle through them.
 bool between(const NormalRef& p, const NormalRef& x, const NormalRef& q) {
@@ -271,9 +275,13 @@ std::vector<ArcPlane> slot_planes(const Polytope& P) {
 
 namespace {
 
-/// locate, with slots_of(v) giving the slot planes for v's region (or null).
-template <class SlotsOf>
-Location walk(const Polytope& P, const SlotsOf& slots_of, const NormalRef& p, int hint, bool step) {
+/// locate, with slots_of(v) giving the slot planes for v's region (or null), and
+/// in_cap_of(v) whether p is certainly inside v's region by its cap (RegionCap).
+template <class SlotsOf, class InCap>
+Location walk(const Polytope& P, const SlotsOf& slots_of, const InCap& in_cap_of,
+              const NormalRef& p, int hint, bool step) {
+  // The hint's cap first: a direction in it is in the hint's region (no step, no region test).
+  if (in_cap_of(hint)) return {Location::Kind::vertex, hint};
   // First one cheap step in doubles: to the neighbour of the hint with the largest support
   // value <p, x>, if it beats the hint's. It only picks where the exact walk starts, which
   // then usually finds the region at once (climbing on to the top in doubles costs a scan
@@ -297,6 +305,7 @@ Location walk(const Polytope& P, const SlotsOf& slots_of, const NormalRef& p, in
   int nzeros = 0;
   const int limit = P.num_vertices() + 16;
   for (int steps = 0; steps < limit; ++steps) {
+    if (v != hint && in_cap_of(v)) return {Location::Kind::vertex, v};
     const int cross = region_test(P, slots_of(v), v, p, zeros, nzeros);
     if (cross < 0) return classify(P, v, zeros, nzeros);
     v = P.fan_vertex[P.fan_begin[v] + cross];
@@ -313,21 +322,68 @@ Location walk(const Polytope& P, const SlotsOf& slots_of, const NormalRef& p, in
 
 Location locate(const Polytope& P, const ArcPlane* slots, const NormalRef& p, int hint, bool step) {
   return walk(
-      P, [slots](int) { return slots; }, p, hint, step);
+      P, [slots](int) { return slots; }, [](int) { return false; }, p, hint, step);
 }
 
 Location locate(const Polytope& P, SlotCache& slots, const NormalRef& p, int hint, bool step) {
+  const UnitNormal& u = p.unit();
   return walk(
-      P, [&slots](int v) { return slots.region(v); }, p, hint, step);
+      P, [&slots](int v) { return slots.region(v); },
+      [&slots, &u](int v) { return slots.has_caps() && in_cap(slots.cap(v), u); }, p, hint, step);
 }
 
-SlotCache::SlotCache(const Polytope& P)
+RegionCap region_cap(const Polytope& P, const ArcPlane* slots, int v) {
+  // Why the cap is safe (all in reals; the margins cover the doubles' rounding, below
+  // 1e-14 here). Let d_i be the signed angle from the centre c to slot i's great circle
+  // (sin d_i = c . P_i / |P_i| =: delta_i, so d_i >= delta_i when positive), and b the angle
+  // between c and a direction u^ = u / |u|. Angles to a great circle are 1-Lipschitz, so
+  // u^'s is at least d_i - b, in (0, pi/2] when b < alpha <= delta_i - 2 beta_i; then
+  // u . P_i = |u| |P_i| sin(its angle) >= |u| |P_i| (d_i - b) / 2 > |u| |P_i| beta_i, with
+  // |P_i| beta_i = 1.1 (P_i.error + kCapQueryError + kUnitPredicateRounding) + 1e-14: above
+  // the filter's bound (arc_filter's) by more than its rounding, so the filter passes on
+  // slot i. And u^ . c > 1 - alpha^2 / 2 + alpha^4 / 24 >= cos(alpha) gives b < alpha.
+  constexpr RegionCap none{0, 0, 0, 2};
+  const int b = P.fan_begin[v], n = P.fan_begin[v + 1] - b;
+  const int* const fan = P.fan_face.data() + b;
+  double cx = 0, cy = 0, cz = 0;  // the centre: the fan's unit normals' mean direction
+  for (int i = 0; i < n; ++i) {
+    const UnitNormal& u = P.unit_normals[fan[i]];
+    cx += u.x, cy += u.y, cz += u.z;
+  }
+  const double length = std::sqrt(cx * cx + cy * cy + cz * cz);
+  if (!(length > 0.5)) return none;
+  const double scale = 1 / length;
+  cx *= scale, cy *= scale, cz *= scale;
+  // alpha = min over the slots of delta_i - 2 beta_i = t_i / |P_i| (all positive), from the
+  // smallest square: one square root in all, and no branch per slot.
+  double alpha2 = 1;  // alpha = 1 (no slot can allow more: delta_i <= 1)
+  bool positive = true;
+  for (int i = 0; i < n; ++i) {
+    const ArcPlane& s = slots[b + i];
+    const double t = cx * s.x + cy * s.y + cz * s.z -
+                     2 * (1.1 * (s.error + kCapQueryError + kUnitPredicateRounding) + 1e-14);
+    const double q = s.x * s.x + s.y * s.y + s.z * s.z;
+    positive &= t > 0 && q > 1e-12;
+    alpha2 = std::min(alpha2, t * t / q);
+  }
+  if (!positive) return none;
+  const double alpha = std::sqrt(alpha2) - 1e-9;  // 1e-9: the rounding, widely
+  // Caps narrower than this would seldom contain a direction: not worth a test.
+  if (!(alpha >= kMinCapAngle)) return none;
+  const double a2 = alpha * alpha;
+  // 1e-9: the rounding of the dot product and of |u|, |c| about 1.
+  return {cx, cy, cz, 1 - a2 / 2 + a2 * a2 / 24 + 1e-9};
+}
+
+SlotCache::SlotCache(const Polytope& P, bool caps)
     : P_(&P),
       planes_(std::make_unique_for_overwrite<ArcPlane[]>(P.fan_face.size())),
+      caps_(caps ? std::make_unique_for_overwrite<RegionCap[]>(P.num_vertices()) : nullptr),
       made_(P.num_vertices(), 0) {}
 
 void SlotCache::make(int v) {
   region_slot_planes(*P_, v, planes_.get());
+  if (caps_) caps_[v] = region_cap(*P_, planes_.get(), v);
   made_[v] = 1;
 }
 

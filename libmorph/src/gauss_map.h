@@ -123,24 +123,52 @@ inline int orient_arc(const Polytope& P, int e, const ArcPlane& plane, const Nor
 Location locate(const Polytope& P, const ArcPlane* slots, const NormalRef& p, int hint,
                 bool step = true);
 
+/// A cap of directions around c (unit, in doubles) where a region's double filter certainly
+/// passes on every slot: a direction whose unit normal u (error at most kCapQueryError) has
+/// u . c > threshold is then in the region's interior, known from one dot product instead of
+/// a test per slot (a walk that stays in its region, the usual one, pays only that). The
+/// threshold is 2, beyond any dot product, where the region has no useful cap.
+struct RegionCap {
+  double x, y, z, threshold;
+};
+/// The largest unit normal error a cap admits (unit normals of double points are within
+/// about 1e-16 of theirs).
+inline constexpr double kCapQueryError = 1e-12;
+/// Whether the cap certainly contains the direction u (see RegionCap).
+inline bool in_cap(const RegionCap& cap, const UnitNormal& u) {
+  return u.x * cap.x + u.y * cap.y + u.z * cap.z > cap.threshold && u.error <= kCapQueryError;
+}
+
 /// P's slot planes (slot_planes), each region's made when a walk first tests it: for one
 /// thread's walks, which then share the making of them with the other threads' instead of
-/// waiting for all to be made first.
+/// waiting for all to be made first. With each region's planes, its RegionCap when `caps`
+/// (making one costs about as much as a few region tests: for many walks per region).
 class SlotCache {
  public:
-  explicit SlotCache(const Polytope& P);
+  explicit SlotCache(const Polytope& P, bool caps = false);
+  bool has_caps() const { return caps_ != nullptr; }
   /// The planes, indexed by slot, those of v's region made.
   const ArcPlane* region(int v) {
     if (!made_[v]) make(v);
     return planes_.get();
+  }
+  /// v's cap (made with its planes; has_caps() only).
+  const RegionCap& cap(int v) {
+    if (!made_[v]) make(v);
+    return caps_[v];
   }
 
  private:
   void make(int v);
   const Polytope* P_;
   std::unique_ptr<ArcPlane[]> planes_;
+  std::unique_ptr<RegionCap[]> caps_;
   std::vector<unsigned char> made_;
 };
+
+/// The cap of v's region (RegionCap) from its slot planes (P's slot_planes, or those of v's
+/// region at least).
+RegionCap region_cap(const Polytope& P, const ArcPlane* slots, int v);
 
 /// locate, with the slots' planes from a SlotCache.
 Location locate(const Polytope& P, SlotCache& slots, const NormalRef& p, int hint,
