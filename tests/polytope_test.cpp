@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "../libmorph/src/validate_detail.h"
 #include "support/polytopes.h"
 
 namespace {
@@ -489,6 +490,109 @@ TEST_CASE("polytope: two triangles a hair from coplanar stay apart when convex, 
     CHECK(p.num_faces() == (eps > 0 ? 7 : 6));
     CHECK(p.num_vertices() == 8);
     check_both_paths(mesh, "bent cube");
+  }
+}
+
+namespace {
+
+// make_operand's check proves every edge of a triangle mesh strictly convex from the heights of
+// its reflex test (validate.cpp, StrictBelow), and the build then skips is_canonical()'s test of
+// the edges: the proof must hold exactly whenever it is given, and never be given for a flat
+// or reflex edge. Whether geometry_passes gives it, on the mesh's own face cycles.
+bool edges_proven(const Mesh& mesh) {
+  std::vector<int> begin{0}, vertex, across;
+  for (auto f : mesh.faces()) {
+    const auto h0 = mesh.halfedge_handle(f);
+    auto h = h0;
+    do {
+      vertex.push_back(mesh.to_vertex_handle(h).idx());
+      across.push_back(mesh.face_handle(mesh.opposite_halfedge_handle(h)).idx());
+      h = mesh.next_halfedge_handle(h);
+    } while (h != h0);
+    begin.push_back(static_cast<int>(vertex.size()));
+  }
+  std::vector<morph::detail::UnitNormal> unit(mesh.n_faces());
+  bool complete = false, convex = false;
+  const bool passes = morph::detail::geometry_passes(
+      mesh, {begin.data(), vertex.data(), across.data()}, unit.data(), complete, convex);
+  return passes && complete && convex;
+}
+
+// Whether every edge of a triangle mesh is strictly convex, decided exactly as is_canonical()
+// defines it: det(N_left, N_right, to - from) > 0 for the exact normals of the two triangles.
+bool exactly_strictly_convex(const Mesh& mesh) {
+  using morph::detail::ExactN;
+  using morph::detail::V3;
+  const auto exact = [&](Mesh::VertexHandle v) {
+    const Point& q = mesh.point(v);
+    return V3<ExactN>{ExactN(q[0]), ExactN(q[1]), ExactN(q[2])};
+  };
+  const auto normal = [&](Mesh::FaceHandle f) {
+    std::vector<V3<ExactN>> c;
+    for (auto v : mesh.fv_range(f)) c.push_back(exact(v));
+    REQUIRE(c.size() == 3);
+    return morph::detail::cross(c[1] - c[0], c[2] - c[0]);
+  };
+  for (auto h : mesh.halfedges()) {
+    const V3<ExactN> d = exact(mesh.to_vertex_handle(h)) - exact(mesh.from_vertex_handle(h));
+    const auto left = mesh.face_handle(h),
+               right = mesh.face_handle(mesh.opposite_halfedge_handle(h));
+    if (CGAL::sign(morph::detail::det(normal(left), normal(right), d)) != CGAL::POSITIVE)
+      return false;
+  }
+  return true;
+}
+
+enum class Proof { given, not_given, either };
+
+void check_edge_proof(const Mesh& mesh, const std::string& what, Proof expected) {
+  CAPTURE(what);
+  const bool proven = edges_proven(mesh);
+  if (expected != Proof::either) CHECK(proven == (expected == Proof::given));
+  if (proven) CHECK(exactly_strictly_convex(mesh));
+  check_both_paths(mesh, what);
+}
+
+}  // namespace
+
+TEST_CASE("polytope: the operand check proves edges strictly convex only when they are") {
+  const Mesh sphere = morph::read_mesh(std::string(MORPH_SAMPLES_DIR) + "/icosphere_1280.off");
+  check_edge_proof(sphere, "icosphere", Proof::given);
+  // (Scaled far from 1, the check leaves the unit normals to compute_normals: no proof.)
+  check_edge_proof(morph::test::scaled(sphere, 0x1p-200), "icosphere 2^-200", Proof::either);
+  check_edge_proof(morph::test::scaled(sphere, 0x1p200), "icosphere 2^200", Proof::either);
+  check_edge_proof(morph::test::transformed(sphere, morph::test::random_rotation(3)),
+                   "icosphere rotated", Proof::given);
+  // Far from the origin the heights round more coarsely (the bound grows with the coordinates).
+  for (const double far : {1e6, 1e9, 1e12}) {
+    CAPTURE(far);
+    const Mesh moved = morph::test::translated(sphere, Point(far, 0, -far));
+    if (edges_proven(moved)) CHECK(exactly_strictly_convex(moved));
+  }
+  // Coplanar triangles (a flat edge) and the bent cube's valley: never proven.
+  check_edge_proof(triangulated(morph::test::cube(2.0)), "triangulated cube", Proof::not_given);
+  // (The ridge of eps = 2^-60 is strictly convex, too shallow for the heights to tell.)
+  for (const double eps : {-0x1p-45, -0x1p-60, 0x1p-60}) {
+    CAPTURE(eps);
+    std::vector<Point> points;
+    for (int i = 0; i < 8; ++i) points.push_back(Point(i & 1, (i >> 1) & 1, (i >> 2) & 1));
+    points[0][2] = -eps;
+    std::vector<std::vector<int>> triangles;
+    for (const auto& q : std::vector<std::vector<int>>{
+             {0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}}) {
+      triangles.push_back({q[0], q[1], q[2]});
+      triangles.push_back({q[0], q[2], q[3]});
+    }
+    check_edge_proof(morph::test::mesh_from_polygons(points, triangles), "bent cube",
+                     eps < 0 ? Proof::not_given : Proof::either);
+  }
+  // A quadrilateral anywhere: left to is_canonical.
+  check_edge_proof(morph::test::cube(2.0), "cube", Proof::not_given);
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    const Mesh random = morph::test::random_sphere_polytope(60, seed);
+    const bool proven = edges_proven(random);
+    if (proven) CHECK(exactly_strictly_convex(random));
+    check_both_paths(random, "sphere " + std::to_string(seed));
   }
 }
 

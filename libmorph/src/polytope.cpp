@@ -745,10 +745,12 @@ void check_edges_convex(const Polytope& p, const char* name) {
 }
 
 /// Whether every edge is strictly convex and every vertex has at least three facets:
-/// then the polytope is canonical as it is (nothing to merge or remove).
-bool is_canonical(const Polytope& p) {
+/// then the polytope is canonical as it is (nothing to merge or remove). `edges_convex`: every
+/// edge is known to be strictly convex (make_operand's check proved it, see geometry_passes).
+bool is_canonical(const Polytope& p, bool edges_convex = false) {
   for (int v = 0; v < p.num_vertices(); ++v)
     if (p.fan_begin[v + 1] - p.fan_begin[v] < 3) return false;
+  if (edges_convex) return true;
   RoundingGuard guard;
   for (const auto& e : p.edges) {
     // edge_convexity's first stage here, so that only what it leaves costs a call.
@@ -1177,11 +1179,14 @@ namespace {
 /// make_polytope(mesh, name, order) once connectivity_from_halfedges has filled p's facets,
 /// edges and fans: the normals, the canonical form, the labels and the Gauss map. The facet
 /// cycles are only read (they end in the result, or stay in p).
-/// `units_known`: p.unit_normals already holds the facets' unit normals.
+/// `units_known`: p.unit_normals already holds the facets' unit normals; `edges_convex`: and
+/// every edge is known to be strictly convex.
 Polytope finish_from_halfedges(Polytope& p, std::vector<int> mesh_edge, const Mesh& mesh,
-                               const char* name, FaceOrder order, bool units_known = false) {
+                               const char* name, FaceOrder order, bool units_known = false,
+                               bool edges_convex = false) {
   p.compute_normals(units_known);
-  if (!is_canonical(p)) return make_polytope_from_cycles(mesh, name, order);
+  if (!is_canonical(p, units_known && edges_convex))
+    return make_polytope_from_cycles(mesh, name, order);
   p.vertex_source.resize(p.num_vertices());
   std::iota(p.vertex_source.begin(), p.vertex_source.end(), 0);
   p.face_source.resize(p.num_faces());
@@ -1242,14 +1247,14 @@ std::optional<Polytope> checked_polytope(const Mesh& mesh, const char* name) {
   // The geometric checks and the rest of the build both only read the facet cycles. The
   // check's verdict decides, as in make_operand.
   std::atomic<bool> rejected{false};
-  bool passes = false, walked = false, units_known = false;
+  bool passes = false, walked = false, units_known = false, edges_convex = false;
   std::optional<Polytope> built;
   std::exception_ptr build_error;
   const auto build = [&] {
     if (rejected) return;
     try {
       built = finish_from_halfedges(p, std::move(mesh_edge), mesh, name, FaceOrder::as_given,
-                                    units_known);
+                                    units_known, edges_convex);
     } catch (...) {
       build_error = std::current_exception();
     }
@@ -1273,12 +1278,13 @@ std::optional<Polytope> checked_polytope(const Mesh& mesh, const char* name) {
   } else {
     // In sequence, the check on the walks' cycles (read once), before the build; the check
     // leaves the facets' unit normals from the planes it computes (the facets are the faces,
-    // the cycles the same), so the build need not compute them again.
+    // the cycles the same), so the build need not compute them again, and proves the edges
+    // strictly convex with them where it can, so the build need not test them again.
     walked = walk() && topology.passes;
     if (!walked) return std::nullopt;
     const FaceCycleView cycles{p.face_begin.data(), p.corner_vertex.data(), topology.across.data()};
     p.unit_normals.resize(p.num_faces());
-    passes = geometry_passes(mesh, cycles, p.unit_normals.data(), units_known);
+    passes = geometry_passes(mesh, cycles, p.unit_normals.data(), units_known, edges_convex);
     rejected = !passes;
     build();
   }

@@ -343,6 +343,34 @@ struct Geometry {
   // whether every face's could be given.
   detail::UnitNormal* unit = nullptr;
   bool unit_complete = true;
+  // With `unit`: whether every edge is proven strictly convex (see StrictBelow).
+  bool edges_proven = false;
+};
+
+// A proof that an edge between two triangles is strictly convex, from the reflex test's height
+// of the far corner v of triangle g across the edge above the plane of triangle f: the edge is
+// strictly convex exactly when v lies strictly below the exact plane of f (det(N_f, N_g, d) =
+// -|d|^2 (v - from) . N_f, as in triangle_edge_convexity(), polytope.cpp), which the computed
+// height h proves when h < -(e_f W + K). With c the computed centroid, n the unit normal (the
+// unit normal left for the polytope: the same values), within e_f of the exact normal's unit
+// vector N, w = v - c, M a bound on |coordinates| and one ulp 2^-52 per operation (any rounding
+// mode): fl(v - c) is within 2^-52 |w|_1 of w and the dot adds at most 3 ulps of |w|_1 |n|_inf,
+// so h is within 4 ulps of W (margins) of w . n, which is within e_f |w| of w . N; and w . N
+// differs from the signed distance of v to the plane by the distance of c to the plane, at
+// most |c - exact centroid| <= 3 * 4 ulps of M (two additions of at most 3M, the rounded
+// 1/3, the product); W bounds |w|_1 (v and c in the bounding box, c up to its rounding);
+// plus an absolute term for underflow.
+struct StrictBelow {
+  double W, K;  // K: the terms that do not scale with e_f
+  StrictBelow(const Extent& extent) {
+    const Point& c = extent.centre;
+    const double M =
+        (std::max({std::abs(c[0]), std::abs(c[1]), std::abs(c[2])}) + extent.diagonal) * 1.01;
+    W = (1.74 * extent.diagonal + 0x1p-48 * M) * 1.01;
+    K = (4 * 0x1p-52 * W + 16 * 0x1p-52 * M) * 1.01 + 1e-300;
+  }
+  // -(e_f W + K), the threshold for face f's heights.
+  double threshold(double error) const { return -(error * W * 1.01 + K); }
 };
 
 // The unit normal that a face's checks leave for the polytope: detail::centroid_unit_normal()
@@ -485,9 +513,14 @@ SmallPlane triangle_plane(const MeshView& m, const int* ids, const Point& centre
   return {cx, cy, cz, nx, ny, nz, volume, 0, length2, magnitude, 3, true};
 }
 
+// kProve: `proven`, when set (the caller has every face's unit normal in `unit`), is left set
+// when the edges with triangles across are proven strictly convex (StrictBelow) and no other
+// face is across, cleared otherwise (without kProve, none of this is compiled).
+template <bool kProve>
 bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, const SmallPlane& q,
                      double tolerance, bool convexity, FanVolumes& volumes, int& non_planar_face,
-                     bool& any_reflex) {
+                     bool& any_reflex, const detail::UnitNormal* unit, const StrictBelow& strict,
+                     bool& proven) {
   if (!q.ok) return false;
   volumes.total += q.first;
   volumes.absolute += std::abs(q.first);
@@ -506,7 +539,8 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, const S
   // ends at corner k); a neighbour that is not a triangle is checked after.
   const int* across = cycles.across + b;
   const int from[3] = {i2, i0, i1}, to[3] = {i0, i1, i2};
-  bool reflex = false, polygon_across = false;
+  bool reflex = false, polygon_across = false, below = true;
+  const double threshold = kProve && proven ? strict.threshold(unit[f].error) : 0;
   for (int k = 0; k < 3; ++k) {
     const int g = across[k];
     const int gb = cycles.begin[g];
@@ -518,8 +552,15 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, const S
     const int v = corners[0] != from[k] && corners[0] != to[k]   ? corners[0]
                   : corners[1] != from[k] && corners[1] != to[k] ? corners[1]
                                                                  : corners[2];
-    reflex = reflex || !(height(m.points[v]) <= tolerance);
+    if constexpr (kProve) {
+      const double h = height(m.points[v]);
+      reflex = reflex || !(h <= tolerance);
+      below = below && h < threshold;
+    } else {
+      reflex = reflex || !(height(m.points[v]) <= tolerance);
+    }
   }
+  if constexpr (kProve) proven = proven && below && !polygon_across;
   if (polygon_across && !reflex) {
     const FacePlane plane{Point(q.cx, q.cy, q.cz), Point(q.nx, q.ny, q.nz)};
     for (int k = 0; k < 3 && !reflex; ++k)
@@ -640,6 +681,9 @@ bool quad_passes(const MeshView& m, const FaceCycles& cycles, int f, const Small
 // `finite`: the caller has found every coordinate finite (the first test is skipped).
 // `shortcuts`: triangles and quadrilaterals take their unrolled paths (off only in tests,
 // which compare the two).
+// kProveEdges: with geometry.unit, also whether the triangles' heights prove every edge strictly
+// convex (geometry.edges_proven; without, none of this is compiled).
+template <bool kProveEdges = false>
 Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& geometry,
                       bool convexity = false, bool finite = false, bool shortcuts = true) {
   for (int v = 0; v < m.n_vertices && !finite; ++v) {
@@ -665,6 +709,10 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
   const Point centre = geometry.extent.centre;
   detail::UnitNormal* const unit = geometry.unit;
   bool unit_complete = geometry.unit_complete;
+  // Every edge proven strictly convex by the triangles' heights (StrictBelow); any other face
+  // leaves the edges to the caller.
+  bool edges_proven = kProveEdges && unit && convexity && shortcuts;
+  const StrictBelow strict(geometry.extent);
   // The faces in blocks: every live triangle's and quadrilateral's plane in the block first
   // (triangle_plane() and quad_plane() change nothing; only these faces' entries are read),
   // then each face's checks in order. Blocks, not every face's plane at once, keep the
@@ -693,9 +741,11 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
       if (!m.live_face(f)) continue;
       const int n = geometry.cycles.degree(f);
       if (n == 3 && shortcuts &&
-          triangle_passes(m, geometry.cycles, f, planes[f - block], tolerance, convexity, volumes,
-                          non_planar_face, reflex))
+          triangle_passes<kProveEdges>(m, geometry.cycles, f, planes[f - block], tolerance,
+                                       convexity, volumes, non_planar_face, reflex, unit, strict,
+                                       edges_proven))
         continue;
+      if constexpr (kProveEdges) edges_proven = false;
       if (n == 4 && shortcuts &&
           quad_passes(m, geometry.cycles, f, planes[f - block], tolerance, convexity, volumes,
                       non_planar_face, reflex))
@@ -750,6 +800,7 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
   geometry.non_planar_face = non_planar_face;
   geometry.reflex = reflex;
   geometry.unit_complete = unit_complete;
+  geometry.edges_proven = edges_proven;
   return {};
 }
 
@@ -901,9 +952,13 @@ Geometry on_cycles(const FaceCycleView& cycles) {
 }
 
 // geometry_passes() once `geometry` holds the face cycles.
-bool geometry_of_cycles_passes(const MeshView& m, Geometry& geometry, double planarity_tolerance) {
-  if (nondegenerate(m, planarity_tolerance, geometry, true, true).verdict != Verdict::ok)
-    return false;
+// `prove_edges`: see nondegenerate (worth it only when every face is a triangle).
+bool geometry_of_cycles_passes(const MeshView& m, Geometry& geometry, double planarity_tolerance,
+                               bool prove_edges = false) {
+  const Finding found = prove_edges
+                            ? nondegenerate<true>(m, planarity_tolerance, geometry, true, true)
+                            : nondegenerate(m, planarity_tolerance, geometry, true, true);
+  if (found.verdict != Verdict::ok) return false;
   if (outward(geometry.volumes).verdict != Verdict::ok) return false;
   // A reflex flag means planar_and_convex() finds a reflex edge (the same test on the same
   // face, edge and vertex): no need to look for it.
@@ -921,12 +976,15 @@ bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles, double plana
 }
 
 bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles, UnitNormal* unit_normals,
-                     bool& complete) {
+                     bool& complete, bool& edges_convex) {
   const MeshView m(mesh, true);  // the caller's precondition
   Geometry geometry = on_cycles(cycles);
   geometry.unit = unit_normals;
-  const bool passes = geometry_of_cycles_passes(m, geometry, kPlanarityTolerance);
+  // The proof needs every face a triangle (it gives up at any other): only then is it tried.
+  const bool triangles = cycles.begin[m.n_faces] == 3LL * m.n_faces;
+  const bool passes = geometry_of_cycles_passes(m, geometry, kPlanarityTolerance, triangles);
   complete = geometry.unit_complete;
+  edges_convex = geometry.edges_proven;
   return passes;
 }
 

@@ -85,9 +85,12 @@ struct UnitNormal;  // polytope.h
 /// direction of the face's exact Newell normal (centroid_unit_normal() of the plane the checks
 /// computed anyway): the values Polytope::compute_normals() gives a facet with this cycle.
 /// `complete` is false when some face's Newell sum is out of that function's range (then the
-/// caller computes them all itself).
+/// caller computes them all itself). `edges_convex` is true when, moreover, every face is a
+/// triangle and every edge is proven strictly convex (the far corner of each triangle across
+/// lies strictly below the exact plane of the face, told from the heights the reflex test
+/// computes): then so is every edge of the polytope with these facets.
 bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles, UnitNormal* unit_normals,
-                     bool& complete);
+                     bool& complete, bool& edges_convex);
 
 /// geometry_passes(mesh, cycles) on the face cycles read here from the mesh (check_operand's),
 /// for a caller that checks beside the halfedge walks that would give them: the same verdict
