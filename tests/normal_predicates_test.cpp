@@ -359,6 +359,47 @@ TEST_CASE("normal predicates: a region's cap holds only directions inside the re
   CHECK(total_in_caps > 1000);
 }
 
+// Within a NearPairScope, orient_undecided decides nearly parallel pairs with the pair's
+// cross product kept from an earlier predicate: each answer must be exact evaluation's, the
+// first time (the product made) and after (kept), in every argument order, on triples of a
+// facet normal, a neighbour's across one of its edges (the arcs the kernel tests) and the
+// closest normals of the other polytope (within 1e-16 on the finer sphere, or exactly
+// parallel under a scale by a power of two), and with nested scopes.
+TEST_CASE("normal predicates: orient_undecided with kept cross products agrees with exact") {
+  const std::vector<std::pair<Mesh, Mesh>> pairs = slot_test_pairs();
+  int decided = 0;
+  for (const auto& [a, b] : pairs) {
+    const Polytope A = morph::detail::make_operand(a, "A");
+    const Polytope B = morph::detail::make_operand(b, "B");
+    const morph::detail::NearPairScope outer(A, B);
+    std::vector<int> order(B.num_faces());
+    int wrong = 0;
+    for (int f = 0; f < A.num_faces(); ++f) {
+      closest_three(B, A.unit_normals[f], order);
+      const morph::detail::NearPairScope inner(A, B);  // nested: kept per facet, then restored
+      for (int k = A.face_begin[f]; k < A.face_begin[f + 1]; ++k) {
+        const auto& e = A.edges[A.corner_edge[k]];
+        const NormalRef n{&A, f}, h{&A, e.left == f ? e.right : e.left};
+        for (int j = 0; j < 3; ++j) {
+          const NormalRef g{&B, order[j]};
+          const NormalRef triples[6][3] = {{n, h, g}, {h, n, g}, {g, n, h},
+                                           {n, g, h}, {h, g, n}, {g, h, n}};
+          for (const auto& t : triples) {
+            const int exact =
+                CGAL::sign(morph::detail::det(t[0].exact(), t[1].exact(), t[2].exact()));
+            for (int repeat = 0; repeat < 2; ++repeat) {
+              wrong += morph::detail::orient_undecided(t[0], t[1], t[2]) != exact;
+              ++decided;
+            }
+          }
+        }
+      }
+    }
+    CHECK(wrong == 0);
+  }
+  CHECK(decided > 0);
+}
+
 // same_normal (gauss_map.h) spares the later stages the predicates on exactly coincident
 // normals (A (+) A, A (+) -A, A (+) an exact translate or a copy scaled by a power of two):
 // it must claim equal directions only where they are exactly equal (not for a copy scaled by

@@ -229,12 +229,121 @@ bool similar_cycles(const Polytope& P, int f, const Polytope& Q, int g) {
   return false;
 }
 
+/// The cross products of NearPairScope: a table of the last pair per hash slot.
+struct NearPairs {
+  struct Entry {
+    const Polytope *px, *py;  // px null: empty
+    int fx, fy;
+    bool valid;  // both precise normals valid
+    double w[3], eps;
+  };
+  static constexpr int kSize = 256;  // a power of two; pairs per sum: about 60 (ico 320 + 1280)
+  const Polytope *a, *b;             // the scope's polytopes
+  Entry entries[kSize];
+};
+
+namespace {
+
+thread_local NearPairs* near_pairs = nullptr;
+
+/// N_x x N_y times a positive factor, as doubles w within eps of it: the double-double cross
+/// product of x's and y's precise normals, as precise_cross in polytope.cpp (the same
+/// operations and bounds; see there). False when a precise normal is not valid.
+bool near_cross(const NormalRef& x, const NormalRef& y, double w[3], double& eps) {
+  CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+  const PreciseNormal& X = x.polytope->precise_normal(x.face);
+  const PreciseNormal& Y = y.polytope->precise_normal(y.face);
+  if (!X.valid || !Y.valid) return false;
+  auto dd = [](const PreciseNormal& n, int i) { return DD{n.hi[i], n.lo[i]}; };
+  auto length = [](const PreciseNormal& n) {
+    return (std::abs(n.hi[0]) + std::abs(n.hi[1]) + std::abs(n.hi[2])) * (1 + 1e-15) + n.error[0] +
+           n.error[1] + n.error[2];
+  };
+  auto error = [](const PreciseNormal& n) { return n.error[0] + n.error[1] + n.error[2]; };
+  eps = 0;
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3, l = (i + 2) % 3;
+    const DD c = dd(X, j) * dd(Y, l) - dd(X, l) * dd(Y, j);
+    const double magnitude =
+        std::abs(X.hi[j]) * std::abs(Y.hi[l]) + std::abs(X.hi[l]) * std::abs(Y.hi[j]);
+    w[i] = c.hi;
+    eps += 32 * kU2 * magnitude * 1.01 + 0x1p-1000 + std::abs(c.lo);
+  }
+  eps += error(X) * length(Y) + length(X) * error(Y);
+  return true;
+}
+
+/// Sign of det(a, b, c), or kUndecided: orient_normals_precise's first stage (orient_near_pair
+/// on the nearly parallel pair, the same choice of pair, the same bound), with the pair's
+/// cross product from `pairs` (undecided for a pair not of the scope's polytopes). Undecided
+/// where that stage is not tried (a component that may be zero in all three: the determinant
+/// may be zero, which only the later stages show; trying this stage first there measured
+/// slower).
+int orient_near_cached(NearPairs& pairs, const NormalRef& a, const NormalRef& b,
+                       const NormalRef& c) {
+  const UnitNormal &ua = a.unit(), &ub = b.unit(), &uc = c.unit();
+  auto may_be_zero = [](double pa, double pb, double pc, double ea, double eb, double ec) {
+    return std::abs(pa) <= ea && std::abs(pb) <= eb && std::abs(pc) <= ec;
+  };
+  if (may_be_zero(ua.x, ub.x, uc.x, ua.error, ub.error, uc.error) ||
+      may_be_zero(ua.y, ub.y, uc.y, ua.error, ub.error, uc.error) ||
+      may_be_zero(ua.z, ub.z, uc.z, ua.error, ub.error, uc.error))
+    return kUndecided;
+  auto dot = [](const UnitNormal& u, const UnitNormal& v) {
+    return std::abs(u.x * v.x + u.y * v.y + u.z * v.z);
+  };
+  const double ab = dot(ua, ub), bc = dot(ub, uc), ca = dot(uc, ua);
+  // det(a, b, c) = c . (a x b) = a . (b x c) = b . (c x a).
+  const NormalRef *x, *y;
+  const UnitNormal* z;
+  if (ab >= bc && ab >= ca)
+    x = &a, y = &b, z = &uc;
+  else if (bc >= ca)
+    x = &b, y = &c, z = &ua;
+  else
+    x = &c, y = &a, z = &ub;
+  auto kept = [&pairs](const Polytope* P) { return P == pairs.a || P == pairs.b; };
+  if (!std::isfinite(z->error) || !kept(x->polytope) || !kept(y->polytope)) return kUndecided;
+  const unsigned hash = (static_cast<unsigned>(x->face) * 0x9E3779B1u) ^
+                        (static_cast<unsigned>(y->face) * 0x85EBCA77u);
+  NearPairs::Entry& e = pairs.entries[(hash >> 16) & (NearPairs::kSize - 1)];
+  if (!(e.px == x->polytope && e.fx == x->face && e.py == y->polytope && e.fy == y->face)) {
+    e.px = x->polytope, e.fx = x->face, e.py = y->polytope, e.fy = y->face;
+    e.valid = near_cross(*x, *y, e.w, e.eps);
+  }
+  if (!e.valid) return kUndecided;
+  // orient_near_pair's evaluation and bound (see there).
+  const double* const w = e.w;
+  const double d = z->x * w[0] + z->y * w[1] + z->z * w[2];
+  const double size = std::abs(w[0]) + std::abs(w[1]) + std::abs(w[2]);
+  const double products = std::abs(z->x * w[0]) + std::abs(z->y * w[1]) + std::abs(z->z * w[2]);
+  const double bound = (z->error * size + e.eps + 4 * 0x1p-52 * products) * 1.01 + 0x1p-1000;
+  if (d > bound) return 1;
+  if (d < -bound) return -1;
+  return kUndecided;
+}
+
+}  // namespace
+
+NearPairScope::NearPairScope(const Polytope& a, const Polytope& b)
+    : pairs_(std::make_unique_for_overwrite<NearPairs>()), previous_(near_pairs) {
+  pairs_->a = &a, pairs_->b = &b;
+  for (auto& e : pairs_->entries) e.px = nullptr;
+  near_pairs = pairs_.get();
+}
+
+NearPairScope::~NearPairScope() { near_pairs = previous_; }
+
 int orient_undecided(const NormalRef& a, const NormalRef& b, const NormalRef& c,
                      bool likely_equal) {
   if (likely_equal
           ? same_normal(a, c) || same_normal(b, c)
           : (same_unit(a, c) && same_normal(a, c)) || (same_unit(b, c) && same_normal(b, c)))
     return 0;
+  if (near_pairs) {
+    const int s = orient_near_cached(*near_pairs, a, b, c);
+    if (s != kUndecided) return s;
+  }
   const int s = orient_normals_precise(a, b, c);
   if (s != kUndecided) return s;
   if (same_normal(a, c) || same_normal(b, c) || same_normal(a, b)) return 0;

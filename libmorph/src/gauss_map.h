@@ -50,6 +50,28 @@ inline bool same_unit(const NormalRef& x, const NormalRef& y) {
   return u.x == v.x && u.y == v.y && u.z == v.z;
 }
 
+struct NearPairs;
+
+/// While alive, the calling thread's orient_undecided keeps the double-double cross products
+/// N_x x N_y of the nearly parallel pairs it meets (the stage that decides them: see
+/// orient_normals_precise), for the other predicates on the same pair: around a facet normal
+/// of one map that a normal of the other nearly coincides with, every arc from it is tested
+/// against that normal (in the walks, the edge facets and the overlay), each a determinant
+/// with the same nearly parallel pair. Only for pairs of normals of a and b, which must
+/// outlive it (a task of another call that the thread runs meanwhile, on other polytopes,
+/// keeps nothing: those may be freed and others made at their addresses). Scopes nest.
+class NearPairScope {
+ public:
+  NearPairScope(const Polytope& a, const Polytope& b);
+  ~NearPairScope();
+  NearPairScope(const NearPairScope&) = delete;
+  NearPairScope& operator=(const NearPairScope&) = delete;
+
+ private:
+  std::unique_ptr<NearPairs> pairs_;
+  NearPairs* previous_;
+};
+
 /// orient_normals_undecided (for what the double filter leaves undecided), with
 /// same_normal's shortcut: two equal directions make the determinant zero. Tried before
 /// the double-double stage when the unit normals hint at it (equal doubles, or, when the

@@ -432,12 +432,17 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
   // likewise, and A's edge facets when A's facets were located in step 1; 3. A's edge
   // facets otherwise (with threads, that case runs otherwise: see below). The chunks'
   // buffers are gathered in the same order whatever the schedule.
+  // The double-double cross products of nearly parallel pairs kept for the calling thread's
+  // predicates (with one thread, all of them).
+  const NearPairScope near_pairs(A, B);
   const int na = A.num_faces(), nb = B.num_faces();
   std::vector<Location> loc_a(na), loc_b(nb);
   std::vector<FacetBuffer> translated, corner, edge, none;
   // Per thread, the slot planes of the map walked on, when they pay (cache_slots).
-  tbb::enumerable_thread_specific<SlotCache> slots_a([&] { return SlotCache(A, cap_regions(A, nb)); });
-  tbb::enumerable_thread_specific<SlotCache> slots_b([&] { return SlotCache(B, cap_regions(B, na)); });
+  tbb::enumerable_thread_specific<SlotCache> slots_a(
+      [&] { return SlotCache(A, cap_regions(A, nb)); });
+  tbb::enumerable_thread_specific<SlotCache> slots_b(
+      [&] { return SlotCache(B, cap_regions(B, na)); });
   const bool cache_a = cache_slots(A, nb), cache_b = cache_slots(B, na);
   const WalkStarts* starts = nullptr;  // null: each walk starts at the previous answer
   // The facets of P at their normals' locations in Q's map: translated facets (P = A), one
