@@ -226,9 +226,11 @@ Pair pair_sqrt(Pair x) {
 #endif
 }
 
+/// `Degree`: the facet's, when known (0: read from the soup); its loop is then unrolled.
+template <int Degree = 0>
 FacetGeometry geometry(const std::vector<V3<double>>& points, const Soup& soup, int f) {
   FacetGeometry g{};  // zeros
-  const int b = soup.begin[f], d = soup.degree(f);
+  const int b = soup.begin[f], d = Degree > 0 ? Degree : soup.degree(f);
   const V3<double>& origin = points[soup.vertex[b]];
   V3<double> sum{0, 0, 0}, centroid{0, 0, 0};
   double longest_squared = 0;  // the root is monotonic: the root of the maximum is the maximum root
@@ -679,7 +681,15 @@ std::optional<Connectivity> connect_with(int num_points, const Soup& soup, Merge
 /// Each facet's geometry, in `geo` (of soup.size() elements).
 void geometries(const std::vector<V3<double>>& points, const Soup& soup, FacetGeometry* geo) {
   parallel_chunks(soup.size(), kFacetGrain, [&](int first, int last) {
-    for (int f = first; f < last; ++f) geo[f] = geometry(points, soup, f);
+    // Triangles and quadrilaterals (nearly all facets, in long runs: the branch is
+    // predicted) by straight-line code: the same operations in the same order.
+    const int* const begin = soup.begin.data();
+    for (int f = first; f < last; ++f) {
+      const int d = begin[f + 1] - begin[f];
+      geo[f] = d == 3   ? geometry<3>(points, soup, f)
+               : d == 4 ? geometry<4>(points, soup, f)
+                        : geometry(points, soup, f);
+    }
   });
 }
 
