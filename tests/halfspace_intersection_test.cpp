@@ -973,6 +973,75 @@ TEST_CASE("halfspace_intersection: the precise side and compare signs are exact"
   CHECK(decided > 0);
 }
 
+// The double filter (the vertices' first test, an a-priori error bound on doubles) decides
+// only true signs: W > 0, <n, X> - d W for a fourth plane moved off the meet by 2^-bits of
+// its size, and <n, Xu> Wv - <n, Xv> Wu for a second vertex moved along n alike, on the
+// precise test's adversarial points (offsets not doubles), with normals scaled so that
+// products underflow (2^-350) or planes leave the filter's range (2^61); far from zero it
+// decides, near zero it leaves the sign to the intervals and the exact stages below.
+TEST_CASE("halfspace_intersection: the double filter's signs are exact") {
+  int decided = 0, undecided = 0, expected = 0;
+  const auto exact_meet = [](const std::vector<HalfSpace>& hs, int first, V3<ExactN>& X,
+                             ExactN& W) {
+    const HalfSpace &a = hs[first], &b = hs[first + 1], &c = hs[first + 2];
+    W = det(a.normal, b.normal, c.normal);
+    const V3<ExactN> bc = cross(b.normal, c.normal), ca = cross(c.normal, a.normal),
+                     ab = cross(a.normal, b.normal);
+    X = {a.offset * bc.x + b.offset * ca.x + c.offset * ab.x,
+         a.offset * bc.y + b.offset * ca.y + c.offset * ab.y,
+         a.offset * bc.z + b.offset * ca.z + c.offset * ab.z};
+  };
+  for (const auto& [p, k] : adversarial_points()) {
+    for (int scale : {0, -350, 50, 61}) {
+      for (int bits : {4, 12, 20, 40, 60, 90}) {
+        for (int sign : {1, -1}) {
+          std::vector<HalfSpace> hs =
+              three_through({1, 0.25, -0.5}, {-0.3, 1, 0.1}, {0.2, -0.7, 1}, p, scale);
+          HalfSpace h = plane_through({0.3, 0.3, 0.9 + 0x1p-30}, p, scale);
+          const double size = std::abs(h.normal.x.to_double() * p.x.to_double()) +
+                              std::abs(h.normal.y.to_double() * p.y.to_double()) +
+                              std::abs(h.normal.z.to_double() * p.z.to_double());
+          h.offset = h.offset + ExactN(std::ldexp(sign * size, -bits));
+          hs.push_back(h);
+          const double big = std::max(
+              {std::abs(p.x.to_double()), std::abs(p.y.to_double()), std::abs(p.z.to_double())});
+          const ExactN t(std::ldexp(sign * big, -bits));
+          const V3<ExactN> q{p.x + t * ExactN(0.3), p.y + t * ExactN(0.3),
+                             p.z + t * ExactN(0.9 + 0x1p-30)};
+          for (const HalfSpace& g :
+               three_through({0.9, -0.2, 0.3}, {0.1, 0.8, -0.4}, {-0.5, 0.2, 0.9}, q, scale))
+            hs.push_back(g);
+          V3<ExactN> Xu, Xv;
+          ExactN Wu, Wv;
+          exact_meet(hs, 0, Xu, Wu);
+          exact_meet(hs, 4, Xv, Wv);
+          const DoubleProbe probe = probe_double(hs);
+          if (probe.w == 1) CHECK(CGAL::sign(Wu) > 0);
+          if (probe.side != 2) CHECK(probe.side == CGAL::sign(dot(h.normal, Xu) - h.offset * Wu));
+          if (probe.compare != 2)
+            CHECK(probe.compare == CGAL::sign(dot(h.normal, Xu) * Wv - dot(h.normal, Xv) * Wu));
+          decided += (probe.side != 2) + (probe.compare != 2);
+          undecided += (probe.side == 2) + (probe.compare == 2);
+          if (scale == 61) CHECK(probe.w == 2);  // out of range: left to the intervals
+          // In range, far from degenerate: decided (p of moderate size, no underflow).
+          const double small = std::min(
+              {std::abs(p.x.to_double()), std::abs(p.y.to_double()), std::abs(p.z.to_double())});
+          if (scale == 0 && small > 1e-4 && big < 1e6 && bits <= 12) {
+            ++expected;
+            CHECK(probe.w == 1);
+            CHECK(probe.side != 2);
+            CHECK(probe.compare != 2);
+          }
+          if (bits >= 60) CHECK(probe.side == 2);
+        }
+      }
+    }
+  }
+  CHECK(decided > 0);
+  CHECK(undecided > 0);
+  CHECK(expected > 0);
+}
+
 // Whole intersections whose vertices are exact ties or just off them: the cube
 // [-m, m]^3 for m a midpoint between doubles (scaled by 2^+-200), and moved by 2^-80 ulp;
 // the rounded result must be the exact one rounded (checked), with or without the exact

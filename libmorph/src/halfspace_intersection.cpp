@@ -84,7 +84,60 @@ struct Plane {
   Interval di;
   // Its normal's or offset's double-double copy, when it has one (denominator 1).
   const HalfSpace* source = nullptr;
+  // The double filter's copy (see kMeetError): each component within one ulp of the exact
+  // one (plus the gap to zero of a subnormal), and their absolute values. `fast` when all
+  // are at most kFastRange (no overflow; underflow then stays below kDoubleFloor).
+  V3<double> nd{}, na{};
+  double dd = 0, da = 0;
+  bool fast = false;
 };
+
+// The double filter. A vertex's X and W (Cramer's rule, meet_of_crosses) are evaluated in
+// doubles from the planes' doubles, each coordinate with its magnitude M: the same
+// polynomial on the absolute values of the inputs with every subtraction turned into an
+// addition. In any rounding mode an operation errs by at most one ulp, v = 2^-52 of its
+// result (while no underflow), and each input double by at most 2v of itself (an interval
+// end, a double-double's hi). Counting the relative error factors (1 + v) along each
+// monomial (Higham's theta_k): an input 2, a cross product 2 (product, difference), then
+// the product and two additions of W = <n_a, bc> or X = d_a bc + d_b ca + d_c ab, so
+// |computed - exact| <= gamma_k M with k = 3 * 2 + 2 + 3 = 11 for X and W (gamma_k =
+// k v / (1 - k v)); the computed magnitude is within (1 + v)^11 of M's exact value. A
+// side <h, X> - d W adds h's 2, a product and three additions: k = 17; a comparison
+// <n, Xu> Wv - <n, Xv> Wu: 2 + 11 + 1 + 2 for <n, X>, then 11 + 1 for the product and 1
+// for the difference: k = 29. The bounds below take 16 v, 32 v and 64 v of the computed
+// magnitude: above gamma_k M with room for the magnitude's own rounding.
+// Underflow: an operation that underflows (or an input that is subnormal) errs by at most
+// 2^-1074 absolutely (a subnormal's spacing, any mode). That error moves the result by at
+// most its derivative with respect to that value, a polynomial in the inputs of degree 6 at
+// most with fewer than 2^10 monomials (the comparison's 648), each of them below 2^360 with
+// every input at most kFastRange = 2^60 in absolute value: fewer than 2^8 operations then
+// move it by less than 2^(-1074 + 360 + 10 + 8): kDoubleFloor = 2^-600 covers them all (and
+// the magnitudes' own underflow). No overflow: every value stays below 2^(420 + 10).
+constexpr double kFastRange = 0x1p60;
+constexpr double kDoubleFloor = 0x1p-600;
+constexpr double kMeetError = 0x1p-48;     // X, W: 16 v of their magnitude
+constexpr double kSideError = 0x1p-47;     // <h, X> - d W: 32 v
+constexpr double kCompareError = 0x1p-46;  // <n, Xu> Wv - <n, Xv> Wu: 64 v
+
+/// Sets a plane's double filter copy (the normal and offset already set as intervals).
+void set_doubles(Plane& p) {
+  const HalfSpace* h = p.source;
+  const auto pick = [](const Interval& i, const DD* dd) { return dd ? dd->hi : i.inf(); };
+  const bool nd = h && h->has_normal_dd, od = h && h->has_offset_dd;
+  p.nd = {pick(p.ni.x, nd ? &h->normal_dd[0] : nullptr),
+          pick(p.ni.y, nd ? &h->normal_dd[1] : nullptr),
+          pick(p.ni.z, nd ? &h->normal_dd[2] : nullptr)};
+  p.dd = pick(p.di, od ? &h->offset_dd : nullptr);
+  p.na = {std::abs(p.nd.x), std::abs(p.nd.y), std::abs(p.nd.z)};
+  p.da = std::abs(p.dd);
+  p.fast = p.na.x <= kFastRange && p.na.y <= kFastRange && p.na.z <= kFastRange &&
+           p.da <= kFastRange;  // (false for NaN)
+}
+
+/// The magnitude of a cross product: |a| x |b| with its subtraction an addition.
+V3<double> magnitude_cross(const V3<double>& a, const V3<double>& b) {
+  return {a.y * b.z + a.z * b.y, a.z * b.x + a.x * b.z, a.x * b.y + a.y * b.x};
+}
 
 /// The enclosure of a double-double copy (HalfSpace::normal_dd, offset_dd: the value lies
 /// within half the gap to a neighbour of hi, plus 2^-101 |hi|, of hi): hi's two neighbours,
@@ -128,6 +181,7 @@ std::vector<Plane> planes_of(const std::vector<HalfSpace>& hs) {
       }
       p.di = q == 1 && hs[i].has_offset_dd ? neighbours_interval(hs[i].offset_dd)
                                            : to_interval_n(*p.d);
+      set_doubles(p);
     }
   });
   return planes;
@@ -211,6 +265,17 @@ struct HVertex {
   bool precise = false;
   bool precise_tried = false;  // make_precise was called (it may have left it out)
   bool doubles = false;  // a known point X / 1 with X exactly doubles: its rounding is X
+  // Xi, Wi and xi are set (`intervals`), or only the double filter's X and W with their
+  // magnitudes (`fast`, made from fast planes: kMeetError), the intervals then made where
+  // that filter cannot decide (make_intervals), most vertices never needing them. Those
+  // doubles are kept in Xi and Wi (X and W as inf, their magnitudes as sup, unchecked): no
+  // room of their own in a vertex that the flips and the checks move by the thousand.
+  bool intervals = false;
+  bool fast = false;
+  V3<double> Xd() const { return {Xi.x.inf(), Xi.y.inf(), Xi.z.inf()}; }
+  V3<double> MX() const { return {Xi.x.sup(), Xi.y.sup(), Xi.z.sup()}; }
+  double Wd() const { return Wi.inf(); }
+  double MW() const { return Wi.sup(); }
 };
 
 /// A candidate dual hull: triangles over plane indices, counter-clockwise seen from
@@ -273,14 +338,81 @@ void meet(const V3<T>& na, const T& da, const V3<T>& nb, const T& db, const V3<T
   meet_of_crosses(na, da, db, dc, cross(nb, nc), cross(nc, na), cross(na, nb), X, W);
 }
 
-/// The interval vertex of three planes (needs a RoundingGuard).
+/// The interval meet of a vertex's three planes, X / W and X, W (needs a RoundingGuard).
+void interval_meet(const std::vector<Plane>& planes, const std::array<int, 3>& abc,
+                   V3<Interval>& Xi, Interval& Wi, V3<Interval>& xi) {
+  const Plane &a = planes[abc[0]], &b = planes[abc[1]], &c = planes[abc[2]];
+  meet(a.ni, a.di, b.ni, b.di, c.ni, c.di, Xi, Wi);
+  xi = {Xi.x / Wi, Xi.y / Wi, Xi.z / Wi};
+}
+/// Gives v its intervals, when it has only doubles (needs a RoundingGuard).
+void make_intervals(const std::vector<Plane>& planes, HVertex& v) {
+  if (v.intervals) return;
+  interval_meet(planes, v.planes, v.Xi, v.Wi, v.xi);
+  v.intervals = true;
+  v.fast = false;  // (its doubles were in Xi and Wi)
+}
+
+/// The double filter's meet of fast planes a, b, c (kMeetError) from the doubles of their
+/// normals' cross products bc, ca, ab and those products' magnitudes (magnitude_cross).
+void double_meet(const Plane& a, const Plane& b, const Plane& c, const V3<double>& bc,
+                 const V3<double>& ca, const V3<double>& ab, const V3<double>& mbc,
+                 const V3<double>& mca, const V3<double>& mab, HVertex& v) {
+  V3<double> X, MX;
+  double W, MW;
+  meet_of_crosses(a.nd, a.dd, b.dd, c.dd, bc, ca, ab, X, W);
+  meet_of_crosses(a.na, a.da, b.da, c.da, mbc, mca, mab, MX, MW);  // (all additions)
+  using Unchecked = Interval::no_check_t;
+  v.Xi = {Interval(X.x, MX.x, Unchecked()), Interval(X.y, MX.y, Unchecked()),
+          Interval(X.z, MX.z, Unchecked())};
+  v.Wi = Interval(W, MW, Unchecked());
+  v.fast = true;
+  v.intervals = false;
+}
+
+/// The vertex of three planes: the double filter's when they are all fast, else intervals
+/// (needs a RoundingGuard).
 HVertex vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& abc) {
   HVertex v;
   v.planes = abc;
   const Plane &a = planes[abc[0]], &b = planes[abc[1]], &c = planes[abc[2]];
-  meet(a.ni, a.di, b.ni, b.di, c.ni, c.di, v.Xi, v.Wi);
-  v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
+  if (a.fast && b.fast && c.fast) {
+    double_meet(a, b, c, cross(b.nd, c.nd), cross(c.nd, a.nd), cross(a.nd, b.nd),
+                magnitude_cross(b.na, c.na), magnitude_cross(c.na, a.na),
+                magnitude_cross(a.na, b.na), v);
+  } else {
+    interval_meet(planes, abc, v.Xi, v.Wi, v.xi);
+    v.intervals = true;
+  }
   return v;
+}
+
+/// An enclosure of X / W (needs a RoundingGuard): the vertex's xi, or, for a vertex with
+/// only doubles, X and W widened by kMeetError of their magnitudes when W > 0 is certain
+/// (fewer operations than the interval meet), else the interval meet.
+V3<Interval> enclosure_of(const std::vector<Plane>& planes, const HVertex& v);
+
+/// Whether W > 0 is certain from the vertex's filter (false: undecided or not positive).
+bool w_positive(const HVertex& v) {
+  if (v.intervals) return v.Wi.inf() > 0;
+  return v.fast && v.Wd() > kMeetError * v.MW() + kDoubleFloor;
+}
+
+V3<Interval> enclosure_of(const std::vector<Plane>& planes, const HVertex& v) {
+  if (v.intervals) return v.xi;
+  if (!w_positive(v)) {
+    V3<Interval> Xi, xi;
+    Interval Wi;
+    interval_meet(planes, v.planes, Xi, Wi, xi);
+    return xi;
+  }
+  const auto widened = [](double x, double m) {
+    const double e = kMeetError * m + kDoubleFloor;  // (rounded up: the guard's mode)
+    return Interval(x) + Interval(-e, e);
+  };
+  const Interval W = widened(v.Wd(), v.MW());
+  const V3<double> X = v.Xd(), M = v.MX();
+  return {widened(X.x, M.x) / W, widened(X.y, M.y) / W, widened(X.z, M.z) / W};
 }
 
 /// Makes v known point k, with its exact coordinates.
@@ -289,6 +421,8 @@ void set_known(const KnownPoints& known, int k, HVertex& v) {
   v.Xi = known.Xi[k];
   v.Wi = known.Wi[k];
   v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
+  v.intervals = true;
+  v.fast = false;
   v.X = &known.X[k];
   v.W = &known.W[k];
 }
@@ -296,7 +430,7 @@ void set_known(const KnownPoints& known, int k, HVertex& v) {
 /// A vertex of three planes taken from a known point when the three pass through one (and
 /// their normals are independent: the meet is then that point).
 void take_known(const KnownPoints& known, HVertex& v) {
-  if (known.empty() || !(v.Wi.inf() > 0)) return;
+  if (known.empty() || !w_positive(v)) return;
   const int k = known.common(v.planes[0], v.planes[1], v.planes[2]);
   if (k >= 0) set_known(known, k, v);
 }
@@ -469,6 +603,8 @@ class PrecisePlanes {
     if (state_[i].load(std::memory_order_acquire) != kMade) make(i);
     return precise_[i];
   }
+  /// Whether plane i's copy is made already (a test that may use it costs no conversion).
+  bool made(int i) const { return state_[i].load(std::memory_order_acquire) == kMade; }
 
  private:
   // Each plane's state: not made, being made (by the thread that claimed it), made. A flag
@@ -564,30 +700,82 @@ void make_precise(const PrecisePlanes& planes, HVertex& v,
   return 2;
 }
 
-/// Sign of <n, x> - d at a vertex from the filters alone (intervals, then the precise
-/// stage in round-to-nearest), or 2: > 0 when the vertex violates the half-space. A known
-/// point skips the precise stage: its exact coordinates are there, and small (in a closing
-/// the undecided tests are mostly exact zeros, planes touching the result).
-int side_filter(const Plane& p, const PrecisePlanes& precise, int i, const HVertex& v) {
-  const int s = interval_sign(dot(p.ni, v.Xi) - p.di * v.Wi);
-  if (s != 2 || !v.precise || v.known >= 0) return s;
-  CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
-  const PrecisePlane& q = precise[i];
-  return q.valid ? precise_side(q, v) : 2;
+/// Sign of <h, X> - d W from the double filter (kSideError), or 2 (any rounding mode).
+int double_side(const Plane& p, const HVertex& v) {
+  if (!p.fast || !v.fast) return 2;
+  const V3<double> X = v.Xd(), M = v.MX();
+  const double value = p.nd.x * X.x + p.nd.y * X.y + p.nd.z * X.z - p.dd * v.Wd();
+  const double bound =
+      kSideError * (p.na.x * M.x + p.na.y * M.y + p.na.z * M.z + p.da * v.MW()) + kDoubleFloor;
+  if (value > bound) return 1;
+  if (value < -bound) return -1;
+  return 2;
+}
+/// Sign of <n, Xu> Wv - <n, Xv> Wu from the double filter (kCompareError), or 2 (any
+/// rounding mode): with Wu, Wv > 0, the sign of <n, u - v>.
+int double_compare(const Plane& p, const HVertex& u, const HVertex& v) {
+  if (!p.fast || !u.fast || !v.fast) return 2;
+  const double nu = dot(p.nd, u.Xd()), nv = dot(p.nd, v.Xd());
+  const double mu = dot(p.na, u.MX()), mv = dot(p.na, v.MX());
+  const double value = nu * v.Wd() - nv * u.Wd();
+  const double bound = kCompareError * (mu * v.MW() + mv * u.MW()) + kDoubleFloor;
+  if (value > bound) return 1;
+  if (value < -bound) return -1;
+  return 2;
+}
+
+/// The interval sign of <n, X> - d W, from v's intervals or, where it has none, ones made
+/// here (not kept: v may be shared between threads).
+int interval_side(const std::vector<Plane>& planes, const Plane& p, const HVertex& v) {
+  if (v.intervals) return interval_sign(dot(p.ni, v.Xi) - p.di * v.Wi);
+  V3<Interval> Xi, xi;
+  Interval Wi;
+  interval_meet(planes, v.planes, Xi, Wi, xi);
+  return interval_sign(dot(p.ni, Xi) - p.di * Wi);
+}
+
+/// Sign of <n, x> - d at a vertex from the filters alone (the double filter, the precise
+/// stage in round-to-nearest, then intervals), or 2: > 0 when the vertex violates the
+/// half-space. A known point skips the precise stage: its exact coordinates are there, and
+/// small (in a closing the undecided tests are mostly exact zeros, planes touching the
+/// result).
+int side_filter(const std::vector<Plane>& planes, const PrecisePlanes& precise, int i,
+                const HVertex& v) {
+  const Plane& p = planes[i];
+  const int s = double_side(p, v);
+  if (s != 2) return s;
+  // The precise stage before intervals (which a vertex with doubles would make here) when
+  // the plane's precise copy is made already; after them otherwise (its conversion costs more).
+  const bool stage = v.precise && v.known < 0;
+  const auto precise_sign = [&] {
+    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    const PrecisePlane& q = precise[i];
+    return q.valid ? precise_side(q, v) : 2;
+  };
+  if (stage && precise.made(i)) {
+    const int t = precise_sign();
+    if (t != 2) return t;
+    return interval_side(planes, p, v);
+  }
+  const int t = interval_side(planes, p, v);
+  return t != 2 || !stage ? t : precise_sign();
 }
 int side_exact(const Plane& p, const HVertex& v) {
   return CGAL::sign(dot(*p.n, *v.X) - *p.d * *v.W);
 }
 
-/// Sign of <n, x> - d for plane i at a vertex: intervals, then the precise stage (the
-/// vertex made precise when first needed there; a known point skips it, as in
-/// side_filter), then exact coordinates (computed once). Planes nearly through one point
+/// Sign of <n, x> - d for plane i at a vertex: the double filter, then the precise stage
+/// (the vertex made precise when first needed there; a known point skips it, as in
+/// side_filter), then intervals, then exact coordinates (computed once). Planes nearly through one point
 /// (the moved facets around a vertex of a nearly planar A) leave most of these tests to
 /// the precise stage.
 int side(const std::vector<Plane>& planes, const PrecisePlanes& precise, int i, HVertex& v) {
   const Plane& p = planes[i];
-  const int s = interval_sign(dot(p.ni, v.Xi) - p.di * v.Wi);
+  int s = double_side(p, v);
   if (s != 2) return s;
+  // A vertex the double filter cannot decide goes to the precise stage before intervals:
+  // most of those the intervals cannot decide either, and the precise coordinates are
+  // needed for the rounding anyway.
   if (v.known < 0) {
     CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
     if (!v.precise_tried) make_precise(precise, v);
@@ -597,19 +785,42 @@ int side(const std::vector<Plane>& planes, const PrecisePlanes& precise, int i, 
       if (t != 2) return t;
     }
   }
+  make_intervals(planes, v);
+  s = interval_sign(dot(p.ni, v.Xi) - p.di * v.Wi);
+  if (s != 2) return s;
   make_exact(planes, v);
   return side_exact(p, v);
 }
 
-/// Sign of <n, u> - <n, v> from the filters alone, or 2 (two known points skip the
-/// precise stage, as in side_filter).
-int compare_filter(const Plane& p, const PrecisePlanes& precise, int i, const HVertex& u,
-                   const HVertex& v) {
-  const int s = interval_sign(dot(p.ni, u.xi) - dot(p.ni, v.xi));
-  if (s != 2 || !u.precise || !v.precise || (u.known >= 0 && v.known >= 0)) return s;
-  CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
-  const PrecisePlane& q = precise[i];
-  return q.valid ? precise_compare(q, u, v) : 2;
+/// Sign of <n, u> - <n, v> from the filters alone (doubles, precise, intervals), or 2 (two
+/// known points skip the precise stage, as in side_filter).
+int compare_filter(const std::vector<Plane>& planes, const PrecisePlanes& precise, int i,
+                   const HVertex& u, const HVertex& v) {
+  const Plane& p = planes[i];
+  const int s = double_compare(p, u, v);
+  if (s != 2) return s;
+  // As in side_filter: the precise stage first when the plane's copy is made.
+  const bool stage = u.precise && v.precise && (u.known < 0 || v.known < 0);
+  const auto precise_sign = [&] {
+    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    const PrecisePlane& q = precise[i];
+    return q.valid ? precise_compare(q, u, v) : 2;
+  };
+  const auto interval_sign_of = [&] {
+    // (Intervals made here where a vertex has none: not kept, the vertices are shared.)
+    V3<Interval> Xi, ui, vi;
+    Interval Wi;
+    if (!u.intervals) interval_meet(planes, u.planes, Xi, Wi, ui);
+    if (!v.intervals) interval_meet(planes, v.planes, Xi, Wi, vi);
+    return interval_sign(dot(p.ni, u.intervals ? u.xi : ui) -
+                         dot(p.ni, v.intervals ? v.xi : vi));
+  };
+  if (stage && precise.made(i)) {
+    const int t = precise_sign();
+    return t != 2 ? t : interval_sign_of();
+  }
+  const int t = interval_sign_of();
+  return t != 2 || !stage ? t : precise_sign();
 }
 int compare_exact(const Plane& p, const HVertex& u, const HVertex& v) {
   return CGAL::sign(dot(*p.n, *u.X) * *v.W - dot(*p.n, *v.X) * *u.W);
@@ -833,21 +1044,23 @@ ExactPoints polytope_points(const std::vector<Plane>& planes, std::vector<HVerte
   if (eager) {
     exact.resize(nv);
     parallel_chunks(nv, 128, [&](int begin, int end) {
+      RoundingGuard guard;  // (make_intervals)
       for (int r = begin; r < end; ++r) {
         HVertex& v = vertex[order[r]];
         make_exact(planes, v);
         exact.numerator[r] = *v.X;
         exact.denominator[r] = *v.W;
-        exact.enclosure[r] = v.xi;
+        exact.enclosure[r] = enclosure_of(planes, v);
       }
     });
     return exact;
   }
   exact.enclosure.resize(nv);
   exact.precise.resize(nv);
+  RoundingGuard guard;  // (make_intervals)
   for (int r = 0; r < nv; ++r) {
     const HVertex& v = vertex[order[r]];
-    exact.enclosure[r] = v.xi;
+    exact.enclosure[r] = enclosure_of(planes, v);
     PrecisePoint& p = exact.precise[r];
     p.doubles = v.doubles;
     if (v.precise) {
@@ -1175,7 +1388,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   const auto oriented = [&](int t) {
     if (!s.has_vertex.empty() && s.has_vertex[t]) {
       const HVertex& v = s.vertex[t];
-      if (v.known < 0 && v.planes == s.corner[t] && v.Wi.inf() > 0) return true;
+      if (v.known < 0 && v.planes == s.corner[t] && w_positive(v)) return true;
     }
     return det_sign(planes[s.corner[t][0]], planes[s.corner[t][1]], planes[s.corner[t][2]]) > 0;
   };
@@ -1521,7 +1734,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   LazyExact exact_vertex(planes, vertex);
   const auto side_of = [&](int i, int v) {
     const Plane& p = planes[i];
-    const int s = side_filter(p, precise, i, vertex[v]);
+    const int s = side_filter(planes, precise, i, vertex[v]);
     return s != 2 ? s : side_exact(p, exact_vertex(v));
   };
   // The candidate is a convex polytope. Every plane that is not a dual vertex must not cut
@@ -1569,7 +1782,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
             s = known_through(known, others[j], vertex[adj[a]]) ? 0 : side_of(i, adj[a]);
             sides.push_back(static_cast<signed char>(s));
           } else {
-            s = compare_filter(p, precise, i, vertex[adj[a]], vertex[u]);
+            s = compare_filter(planes, precise, i, vertex[adj[a]], vertex[u]);
             if (s == 2) s = compare_exact(p, exact_vertex(adj[a]), exact_vertex(u));
           }
           if (s > 0) {
@@ -1672,6 +1885,10 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   {
     std::vector<int> cyc(face_vertex.begin(), face_vertex.begin() + face_begin[1]);
     for (int& r : cyc) r = order[r];
+    {
+      RoundingGuard guard;
+      for (int r : cyc) make_intervals(planes, vertex[r]);
+    }
     if (clockwise(cyc, vertex, hs[face_halfspace[0]].normal, exact_vertex))
       for (int f = 0; f < nf; ++f)
         std::reverse(face_vertex.begin() + face_begin[f], face_vertex.begin() + face_begin[f + 1]);
@@ -1699,7 +1916,11 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
                                        inverse, rounded[i]))
           continue;
         const HVertex& e = exact_vertex(order[r]);
-        rounded[i] = round_quotient(coordinate(*e.X, i), *e.W, coordinate(v.xi, i));
+        // (Any estimate serves: round_quotient only starts from it.)
+        const double q = v.intervals ? 0 : coordinate(v.Xd(), i) / v.Wd();
+        const Interval estimate = v.intervals ? coordinate(v.xi, i)
+                                              : Interval(std::isfinite(q) ? q : 0.0);
+        rounded[i] = round_quotient(coordinate(*e.X, i), *e.W, estimate);
       }
       rp.points[r] = {rounded[0], rounded[1], rounded[2]};
     }
@@ -1804,6 +2025,7 @@ class IncrementalHull {
         v.Xi = tri.Xi;
         v.Wi = tri.Wi;
         v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
+        v.intervals = true;
         if (tri.precise >= 0) {
           const HVertex& q = precise_vertex_[tri.precise];
           v.px = q.px;
@@ -2111,6 +2333,19 @@ PreciseProbe probe_precise(const std::vector<HalfSpace>& hs) {
   return out;
 }
 
+DoubleProbe probe_double(const std::vector<HalfSpace>& hs) {
+  const std::vector<Plane> planes = planes_of(hs);
+  RoundingGuard guard;  // (vertex_of's intervals for planes that are not fast)
+  DoubleProbe out;
+  const HVertex u = vertex_of(planes, {0, 1, 2});
+  out.w = w_positive(u) && u.fast ? 1 : 2;
+  if (hs.size() < 4) return out;
+  out.side = double_side(planes[3], u);
+  if (hs.size() < 7) return out;
+  out.compare = double_compare(planes[3], u, vertex_of(planes, {4, 5, 6}));
+  return out;
+}
+
 PreciseProbe probe_precise_point(const V3<ExactN>& X, const ExactN& W) {
   CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
   PreciseProbe out;
@@ -2189,6 +2424,7 @@ struct PolygonScratch {
   std::vector<char> ready;                   // whether its vertex is computed
   std::vector<std::pair<int, int>> pending;  // diagonals to test
   std::vector<V3<Interval>> cross;           // n_i x n_j of positions i, j (k i + j)
+  std::vector<V3<double>> dcross, mcross;    // the same in doubles, and its magnitude
   std::vector<char> has_cross;
   std::vector<signed char> diagonal_side;  // of diagonal i, j (k i + j, i < j), or 2
   std::vector<int> owner;  // 3 t + slot of the triangle t holding edge i -> j (k i + j), or -1
@@ -2254,7 +2490,15 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
     if (i > 1) pending.emplace_back(0, i);
   }
   ready.assign(triangle.size(), 0);
-  scratch.cross.resize(static_cast<std::size_t>(k) * k);
+  // All planes fast (the usual case): the vertices are the double filter's (double_meet).
+  bool fast = true;
+  for (int i = 0; i < k; ++i) fast = fast && planes[p[i]].fast;
+  if (fast) {
+    scratch.dcross.resize(static_cast<std::size_t>(k) * k);
+    scratch.mcross.resize(static_cast<std::size_t>(k) * k);
+  } else {
+    scratch.cross.resize(static_cast<std::size_t>(k) * k);
+  }
   scratch.has_cross.assign(static_cast<std::size_t>(k) * k, 0);
   scratch.diagonal_side.assign(static_cast<std::size_t>(k) * k, 2);
   const auto diagonal_side = [&](int a, int c) -> signed char& {
@@ -2274,6 +2518,23 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
     scratch.has_cross[i * k + j] = 1;
     return c;
   };
+  // The same in doubles for fast planes (negation is exact, and the magnitude symmetric:
+  // the same values as computed afresh); returns the index of both.
+  const auto double_cross_of = [&](int i, int j) {
+    const int at = i * k + j;
+    if (scratch.has_cross[at]) return at;
+    if (scratch.has_cross[j * k + i]) {
+      const V3<double>& r = scratch.dcross[j * k + i];
+      scratch.dcross[at] = {-r.x, -r.y, -r.z};
+      scratch.mcross[at] = scratch.mcross[j * k + i];
+    } else {
+      const Plane &a = planes[p[i]], &b = planes[p[j]];
+      scratch.dcross[at] = cross(a.nd, b.nd);
+      scratch.mcross[at] = magnitude_cross(a.na, b.na);
+    }
+    scratch.has_cross[at] = 1;
+    return at;
+  };
   // Triangle t's vertex, as vertex_of(planes, abc, known) computes it but for xi, which
   // the flips' tests do not use: made for the final triangles only.
   const auto compute_vertex = [&](int t) {
@@ -2288,8 +2549,17 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
     v.precise = v.precise_tried = false;
     v.planes = {p[i], p[j], p[l]};
     const Plane &a = planes[p[i]], &b = planes[p[j]], &c = planes[p[l]];
-    meet_of_crosses(a.ni, a.di, b.di, c.di, cross_of(j, l), cross_of(l, i), cross_of(i, j), v.Xi,
-                    v.Wi);
+    if (fast) {
+      const int bc = double_cross_of(j, l), ca = double_cross_of(l, i), ab = double_cross_of(i, j);
+      const auto& d = scratch.dcross;
+      const auto& m = scratch.mcross;
+      double_meet(a, b, c, d[bc], d[ca], d[ab], m[bc], m[ca], m[ab], v);
+    } else {
+      meet_of_crosses(a.ni, a.di, b.di, c.di, cross_of(j, l), cross_of(l, i), cross_of(i, j),
+                      v.Xi, v.Wi);
+      v.intervals = true;
+      v.fast = false;
+    }
     take_known(known, v);  // (a known point's xi is set)
   };
   // Triangle t's vertex (computed when first tested); false when t is not positively
@@ -2298,7 +2568,7 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
     if (ready[t]) return true;
     compute_vertex(t);
     const std::array<int, 3>& abc = vertex[t].planes;
-    return vertex[t].Wi.inf() > 0 || det_sign(planes[abc[0]], planes[abc[1]], planes[abc[2]]) > 0;
+    return w_positive(vertex[t]) || det_sign(planes[abc[0]], planes[abc[1]], planes[abc[2]]) > 0;
   };
   // The triangle holding the directed edge a -> c and that edge's slot in it, or -1.
   const auto find = [&](int a, int c, int& slot) {
@@ -2356,7 +2626,7 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
     }
     if (!ready[t]) compute_vertex(static_cast<int>(t));
     HVertex& v = vertex[t];
-    if (v.known < 0) v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
+    if (v.known < 0 && v.intervals) v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
     out_has[t] = 1;
   }
   return true;

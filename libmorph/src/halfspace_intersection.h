@@ -169,6 +169,17 @@ PreciseProbe probe_precise(const std::vector<HalfSpace>& hs);
 /// The rounding of a point known exactly, X / W (W > 0), as an erosion's known points.
 PreciseProbe probe_precise_point(const V3<ExactN>& X, const ExactN& W);
 
+/// For tests: the double filter alone (the first stage of the vertices' tests, before
+/// intervals), on hs as probe_precise's: 1 where it finds W = det(n_0, n_1, n_2) > 0 (`w`),
+/// and the signs of <n, X> - d W for hs[3] (`side`) and <n, Xu> Wv - <n, Xv> Wu (`compare`)
+/// where it decides them; 2 elsewhere (also where a plane is out of its range).
+struct DoubleProbe {
+  int w = 2;
+  int side = 2;
+  int compare = 2;
+};
+DoubleProbe probe_double(const std::vector<HalfSpace>& hs);
+
 /// One coordinate of X / W + b rounded to nearest (ties to even), for X / W a vertex given
 /// by its precise coordinates (a PrecisePoint's X.x, error.x, W, w_error, or y, or z) and b a
 /// double, when the precise stage decides; false when the sum lies too close to a rounding
