@@ -561,3 +561,43 @@ TEST_CASE("index_vertices numbers the distinct pairs in order, listed by either 
     CHECK(wrong == 0);
   }
 }
+
+// A vertex with many partners (the apex of a fine cone against a fine sphere) would make the
+// one-thread lists quadratic in them: index_vertices gives the lists up and numbers by
+// buckets instead. Either way the numbering must be the same: pairs sorted, each once.
+TEST_CASE("index_vertices numbers a vertex with many partners, listed by either operand") {
+  for (const bool more_b : {false, true}) {
+    const int num_listed = 3000, num_other = 2000;
+    const int num_a = more_b ? num_other : num_listed, num_b = more_b ? num_listed : num_other;
+    morph::detail::SumFacets facets;
+    std::set<std::uint64_t> expected;
+    const auto add = [&](int listed, int other) {
+      const std::uint64_t key = more_b ? morph::detail::pair_key(other, listed)
+                                       : morph::detail::pair_key(listed, other);
+      facets.corners.push_back(key);
+      expected.insert(key);
+    };
+    // Triangles around listed vertex 7 with every vertex of the other operand, each pair in
+    // three of them (as a fan of corner and edge facets would use it), out of order.
+    for (int round = 0; round < 3; ++round)
+      for (int k = 0; k < num_other; ++k) {
+        const int other = (k * 7919 + round * 13) % num_other;
+        add(7, other);
+        add(100 + other, other);
+        add(7, (other + 1) % num_other);
+        facets.face_begin.push_back(static_cast<int>(facets.corners.size()));
+      }
+    std::vector<std::uint64_t> pairs;
+    std::vector<int> corners;
+    morph::detail::run_with_threads(1, [&] {
+      morph::detail::index_vertices(facets, num_a, num_b, pairs, corners);
+    });
+    CHECK(pairs == std::vector<std::uint64_t>(expected.begin(), expected.end()));
+    REQUIRE(corners.size() == facets.corners.size());
+    int wrong = 0;
+    for (std::size_t c = 0; c < corners.size(); ++c)
+      wrong += corners[c] < 0 || corners[c] >= static_cast<int>(pairs.size()) ||
+               pairs[corners[c]] != facets.corners[c];
+    CHECK(wrong == 0);
+  }
+}

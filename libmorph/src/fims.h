@@ -33,8 +33,9 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B);
 /// each corner's index among them (sum_mesh and sum_polytope number S's vertices so).
 /// Linear in the number of corners: with one thread, each corner's pair is looked up among
 /// the few found so far at its vertex of the operand with more vertices, and the pairs are
-/// then counting-sorted; with threads, a counting sort buckets the corners by their vertex
-/// of A, and in each bucket only the few distinct partners in B are sorted.
+/// then counting-sorted; with threads (or when a vertex has so many partners that the lists
+/// would cost more than a few steps a corner), a counting sort buckets the corners by their
+/// vertex of A, and in each bucket only the distinct partners in B are sorted.
 void index_vertices(const SumFacets& facets, int num_a, int num_b,
                     std::vector<std::uint64_t>& pairs, std::vector<int>& corners);
 

@@ -570,8 +570,13 @@ int distinct_partners(const int* partner, int b, int e, int* slot, int* out) {
 /// counting sorts over the pairs (by j, then stably by i: about a quarter as many as the
 /// corners) and the corners renumbered. Random accesses stay within arrays of a vertex or
 /// pair each, rather than scattering the corners into buckets and back.
-void index_vertices_serial(const SumFacets& facets, int num_a, int num_b,
+/// A vertex with many partners (the apex of a fine cone against a fine sphere) would make the
+/// list searches quadratic in its partners: past kListStepsPerCorner steps a corner on
+/// average, this gives up (false, nothing written that the caller keeps) and the caller
+/// numbers by buckets, linear whatever the partners.
+bool index_vertices_serial(const SumFacets& facets, int num_a, int num_b,
                            std::vector<std::uint64_t>& pairs, std::vector<int>& corners) {
+  constexpr long kListStepsPerCorner = 4;
   const int nc = static_cast<int>(facets.corners.size());
   corners.resize(nc);
   struct Found {
@@ -584,11 +589,16 @@ void index_vertices_serial(const SumFacets& facets, int num_a, int num_b,
   int* const corner = corners.data();
   const auto find_pairs = [&](auto by_b, int num_listed) {
     std::vector<int> last(num_listed, -1);  // the pair last found at each listed vertex
+    long steps_left = kListStepsPerCorner * nc + 64;
     for (int c = 0; c < nc; ++c) {
       const int i = pair_first(key[c]), j = pair_second(key[c]);
       int& head = last[by_b ? j : i];
       int n = head;
-      while (n >= 0 && (by_b ? found[n].i != i : found[n].j != j)) n = found[n].next;
+      while (n >= 0 && (by_b ? found[n].i != i : found[n].j != j)) {
+        n = found[n].next;
+        --steps_left;
+      }
+      if (steps_left < 0) return false;
       if (n < 0) {
         n = num_pairs++;
         found[n] = {i, j, head};
@@ -596,11 +606,10 @@ void index_vertices_serial(const SumFacets& facets, int num_a, int num_b,
       }
       corner[c] = n;
     }
+    return true;
   };
-  if (num_b > num_a)
-    find_pairs(std::true_type{}, num_b);
-  else
-    find_pairs(std::false_type{}, num_a);
+  if (!(num_b > num_a ? find_pairs(std::true_type{}, num_b) : find_pairs(std::false_type{}, num_a)))
+    return false;
   // The pairs in order of j (counting sort), then stably of i: sorted by (i, j).
   const auto by_j = std::make_unique_for_overwrite<int[]>(num_pairs);
   {
@@ -623,6 +632,7 @@ void index_vertices_serial(const SumFacets& facets, int num_a, int num_b,
     }
   }
   for (int c = 0; c < nc; ++c) corner[c] = place[corner[c]];
+  return true;
 }
 
 }  // namespace
@@ -630,13 +640,13 @@ void index_vertices_serial(const SumFacets& facets, int num_a, int num_b,
 void index_vertices(const SumFacets& facets, int num_a, int num_b,
                     std::vector<std::uint64_t>& pairs, std::vector<int>& corners) {
   const int nc = static_cast<int>(facets.corners.size());
-  // Large results with threads to spare: the buckets of a counting sort by vertex of A are
-  // numbered in two parallel passes (below).
+  // Large results with threads to spare, or a vertex with too many partners for the lists
+  // (index_vertices_serial gives up): the buckets of a counting sort by vertex of A are
+  // numbered in two passes, parallel with threads (below).
   constexpr int kParallelCorners = 1 << 17;
-  if (nc < kParallelCorners || tbb::this_task_arena::max_concurrency() == 1) {
-    index_vertices_serial(facets, num_a, num_b, pairs, corners);
+  if ((nc < kParallelCorners || tbb::this_task_arena::max_concurrency() == 1) &&
+      index_vertices_serial(facets, num_a, num_b, pairs, corners))
     return;
-  }
   // first[i]..first[i + 1]: the corners at vertex i of A, in `by_a`, with their vertex of B
   // in `partner` (read in order below rather than through by_a).
   std::vector<int> first(num_a + 1, 0);
