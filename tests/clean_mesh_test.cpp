@@ -524,6 +524,98 @@ TEST_CASE("clean_mesh tests the corners of merged polygons only") {
   }
 }
 
+// Several separate merges among many facets that stay as they are (copied in runs): some
+// facets of a sphere polytope are split into fans around their centroid (that vertex goes),
+// and some of those also get the midpoint of an edge, which goes too and so changes the
+// facet across that edge, a group of its own. The mesh must be the unsplit facets' one,
+// vertex for vertex and face for face (each cycle from the same corner), with 1 and 2 threads.
+TEST_CASE("clean_mesh merges a few groups among many facets as the facets were before") {
+  const morph::Mesh sphere = morph::test::random_sphere_polytope(600, 11);
+  std::vector<V3<double>> points;
+  for (auto v : sphere.vertices()) {
+    const auto p = sphere.point(v);
+    points.push_back({p[0], p[1], p[2]});
+  }
+  std::vector<std::vector<int>> faces;
+  for (auto f : sphere.faces()) {
+    faces.emplace_back();
+    for (auto v : sphere.fv_range(f)) faces.back().push_back(v.idx());
+  }
+  REQUIRE(faces.size() > 1024);  // more than two chunks of facets (kFacetGrain)
+  // Midpoints on the first edge of every other split facet, inserted on both sides.
+  std::map<std::pair<int, int>, int> midpoint;  // directed edge -> point
+  std::vector<char> split(faces.size(), 0);
+  int splits = 0;
+  for (std::size_t f = 3; f < faces.size(); f += 97) {
+    split[f] = 1;
+    ++splits;
+    if (splits % 2 == 0) continue;
+    const int u = faces[f][0], w = faces[f][1];
+    if (midpoint.count({w, u})) continue;
+    points.push_back({(points[u].x + points[w].x) / 2, (points[u].y + points[w].y) / 2,
+                      (points[u].z + points[w].z) / 2});
+    midpoint[{u, w}] = midpoint[{w, u}] = static_cast<int>(points.size()) - 1;
+  }
+  REQUIRE(splits >= 8);
+  std::vector<int> begin{0}, corners, plain_begin{0}, plain_corners;
+  for (std::size_t f = 0; f < faces.size(); ++f) {
+    const std::vector<int>& face = faces[f];
+    const int d = static_cast<int>(face.size());
+    plain_corners.insert(plain_corners.end(), face.begin(), face.end());
+    plain_begin.push_back(static_cast<int>(plain_corners.size()));
+    std::vector<int> cycle;  // with the midpoints
+    for (int i = 0; i < d; ++i) {
+      cycle.push_back(face[i]);
+      const auto m = midpoint.find({face[i], face[(i + 1) % d]});
+      if (m != midpoint.end()) cycle.push_back(m->second);
+    }
+    if (!split[f]) {
+      corners.insert(corners.end(), cycle.begin(), cycle.end());
+      begin.push_back(static_cast<int>(corners.size()));
+      continue;
+    }
+    V3<double> centre{0, 0, 0};
+    for (const int v : face) centre = {centre.x + points[v].x, centre.y + points[v].y,
+                                       centre.z + points[v].z};
+    points.push_back({centre.x / d, centre.y / d, centre.z / d});
+    const int c = static_cast<int>(points.size()) - 1;
+    // Fan triangles (a quad where a midpoint is), the first from the facet's first corner.
+    for (std::size_t i = 0; i < cycle.size();) {
+      corners.push_back(c);
+      corners.push_back(cycle[i]);
+      std::size_t j = i + 1;
+      for (; j < cycle.size() && std::find(face.begin(), face.end(), cycle[j]) == face.end(); ++j)
+        corners.push_back(cycle[j]);
+      corners.push_back(cycle[j % cycle.size()]);
+      begin.push_back(static_cast<int>(corners.size()));
+      i = j;
+    }
+  }
+  const long fallbacks = morph::detail::clean_mesh_hull_fallbacks();
+  for (int threads : {1, 2}) {
+    CAPTURE(threads);
+    std::vector<int> source, plain_source;
+    const morph::Mesh expected = morph::detail::run_with_threads(
+        threads, [&] { return clean_mesh(points, plain_begin, plain_corners, &plain_source); });
+    const morph::Mesh mesh = morph::detail::run_with_threads(
+        threads, [&] { return clean_mesh(points, begin, corners, &source); });
+    REQUIRE(expected.n_faces() == faces.size());
+    REQUIRE(mesh.n_vertices() == expected.n_vertices());
+    REQUIRE(mesh.n_faces() == expected.n_faces());
+    CHECK(mesh.n_edges() == expected.n_edges());
+    CHECK(source.size() == plain_source.size());
+    for (auto v : expected.vertices())
+      CHECK(mesh.point(morph::Mesh::VertexHandle(v.idx())) == expected.point(v));
+    for (auto f : expected.faces()) {
+      std::vector<int> a, b;
+      for (auto v : expected.fv_range(f)) a.push_back(v.idx());
+      for (auto v : mesh.fv_range(morph::Mesh::FaceHandle(f.idx()))) b.push_back(v.idx());
+      CHECK(a == b);
+    }
+  }
+  CHECK(morph::detail::clean_mesh_hull_fallbacks() == fallbacks);
+}
+
 }  // namespace
 
 // index_vertices with one thread finds the distinct pairs in lists at the vertices of the

@@ -534,8 +534,45 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
   const char* const kept = keep.data();
   int *const out_vertex = out.vertex.data(), *const chain_of_data = chain_of.data(),
              *const chain_end_data = chain_end.data();
+  // The facets with a vertex that goes (few: those around the vertices inside a merged
+  // group or in the middle of an edge), found over the fans of those vertices. A facet that
+  // is its own group and has none is its polygon as it is: runs of such facets are copied
+  // whole below, rather than corner by corner.
+  std::vector<char> touched(nf, 0);
+  for (int v = 0; v < np; ++v) {
+    if (keep[v] || out_begin[v + 1] == out_begin[v]) continue;
+    const int c = k.first_out[v];
+    int e = c, steps = 0;
+    do {
+      touched[k.face[e]] = 1;
+      e = k.twin[k.prev[e]];
+    } while (e != c && ++steps <= nc);
+  }
+  const auto plain = [&](int f) {
+    return groups.of[f] == f && groups.next_member[f] < 0 && !touched[f];
+  };
+  const int* const soup_begin = soup.begin.data();
   for (int g = 0; g < nf; ++g) {
     if (groups.of[g] != g) continue;
+    if (plain(g)) {
+      // Facets g to h - 1: each keeps all its corners, in order, and its source.
+      int h = g + 1;
+      while (h < nf && plain(h)) ++h;
+      const int b = soup_begin[g], e = soup_begin[h], shift = size - b;
+      for (int c = b; c < e; ++c) {
+        out_vertex[c + shift] = vertex[c];
+        chain_of_data[c] = c + shift;
+        chain_end_data[c + shift] = c;
+      }
+      for (int f = g; f < h; ++f) {
+        if (soup_begin[f + 1] - soup_begin[f] < 3) return false;
+        out.source[polygons] = soup.source[f];
+        out.begin[++polygons] = soup_begin[f + 1] + shift;
+      }
+      size += e - b;
+      g = h - 1;
+      continue;
+    }
     const int first = size;
     int before_first = -1;  // the last corner walked before the first kept one
     const auto add = [&](int c) {
