@@ -575,8 +575,8 @@ TEST_CASE("clean_mesh merges a few groups among many facets as the facets were b
       continue;
     }
     V3<double> centre{0, 0, 0};
-    for (const int v : face) centre = {centre.x + points[v].x, centre.y + points[v].y,
-                                       centre.z + points[v].z};
+    for (const int v : face)
+      centre = {centre.x + points[v].x, centre.y + points[v].y, centre.z + points[v].z};
     points.push_back({centre.x / d, centre.y / d, centre.z / d});
     const int c = static_cast<int>(points.size()) - 1;
     // Fan triangles (a quad where a midpoint is), the first from the facet's first corner.
@@ -616,6 +616,23 @@ TEST_CASE("clean_mesh merges a few groups among many facets as the facets were b
   CHECK(morph::detail::clean_mesh_hull_fallbacks() == fallbacks);
 }
 
+// index_vertices at one thread must give the distinct pairs `expected`, sorted, each once, and
+// each corner its own pair's index.
+void check_numbering(const morph::detail::SumFacets& facets, int num_a, int num_b,
+                     const std::set<std::uint64_t>& expected) {
+  std::vector<std::uint64_t> pairs;
+  std::vector<int> corners;
+  morph::detail::run_with_threads(
+      1, [&] { morph::detail::index_vertices(facets, num_a, num_b, pairs, corners); });
+  CHECK(pairs == std::vector<std::uint64_t>(expected.begin(), expected.end()));
+  REQUIRE(corners.size() == facets.corners.size());
+  int wrong = 0;
+  for (std::size_t c = 0; c < corners.size(); ++c)
+    wrong += corners[c] < 0 || corners[c] >= static_cast<int>(pairs.size()) ||
+             pairs[corners[c]] != facets.corners[c];
+  CHECK(wrong == 0);
+}
+
 }  // namespace
 
 // index_vertices with one thread finds the distinct pairs in lists at the vertices of the
@@ -639,18 +656,7 @@ TEST_CASE("index_vertices numbers the distinct pairs in order, listed by either 
       }
       facets.face_begin.push_back(static_cast<int>(facets.corners.size()));
     }
-    std::vector<std::uint64_t> pairs;
-    std::vector<int> corners;
-    morph::detail::run_with_threads(1, [&] {
-      morph::detail::index_vertices(facets, num_a, num_b, pairs, corners);
-    });
-    CHECK(pairs == std::vector<std::uint64_t>(expected.begin(), expected.end()));
-    REQUIRE(corners.size() == facets.corners.size());
-    int wrong = 0;
-    for (std::size_t c = 0; c < corners.size(); ++c)
-      wrong += corners[c] < 0 || corners[c] >= static_cast<int>(pairs.size()) ||
-               pairs[corners[c]] != facets.corners[c];
-    CHECK(wrong == 0);
+    check_numbering(facets, num_a, num_b, expected);
   }
 }
 
@@ -664,8 +670,8 @@ TEST_CASE("index_vertices numbers a vertex with many partners, listed by either 
     morph::detail::SumFacets facets;
     std::set<std::uint64_t> expected;
     const auto add = [&](int listed, int other) {
-      const std::uint64_t key = more_b ? morph::detail::pair_key(other, listed)
-                                       : morph::detail::pair_key(listed, other);
+      const std::uint64_t key =
+          more_b ? morph::detail::pair_key(other, listed) : morph::detail::pair_key(listed, other);
       facets.corners.push_back(key);
       expected.insert(key);
     };
@@ -679,17 +685,6 @@ TEST_CASE("index_vertices numbers a vertex with many partners, listed by either 
         add(7, (other + 1) % num_other);
         facets.face_begin.push_back(static_cast<int>(facets.corners.size()));
       }
-    std::vector<std::uint64_t> pairs;
-    std::vector<int> corners;
-    morph::detail::run_with_threads(1, [&] {
-      morph::detail::index_vertices(facets, num_a, num_b, pairs, corners);
-    });
-    CHECK(pairs == std::vector<std::uint64_t>(expected.begin(), expected.end()));
-    REQUIRE(corners.size() == facets.corners.size());
-    int wrong = 0;
-    for (std::size_t c = 0; c < corners.size(); ++c)
-      wrong += corners[c] < 0 || corners[c] >= static_cast<int>(pairs.size()) ||
-               pairs[corners[c]] != facets.corners[c];
-    CHECK(wrong == 0);
+    check_numbering(facets, num_a, num_b, expected);
   }
 }

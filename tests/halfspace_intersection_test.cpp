@@ -921,6 +921,34 @@ TEST_CASE("halfspace_intersection: the precise stage rounds next to powers of tw
   CHECK(decided > 100);
 }
 
+namespace {
+
+// Seven planes around an adversarial point p: three through p (scaled by 2^scale), a fourth
+// through p moved by 2^-bits of the magnitude of <n, p> (sign: its direction), and three
+// through q (scaled by 2^q_scale), p moved along the fourth plane's normal by 2^-bits of p's
+// size (the sign of <n, p - q> is -sign).
+std::vector<HalfSpace> moved_fourth(const V3<ExactN>& p, int scale, int q_scale, int bits,
+                                    int sign, V3<ExactN>& q) {
+  std::vector<HalfSpace> hs =
+      three_through({1, 0.25, -0.5}, {-0.3, 1, 0.1}, {0.2, -0.7, 1}, p, scale);
+  HalfSpace h = plane_through({0.3, 0.3, 0.9 + 0x1p-30}, p, scale);
+  const double size = std::abs(h.normal.x.to_double() * p.x.to_double()) +
+                      std::abs(h.normal.y.to_double() * p.y.to_double()) +
+                      std::abs(h.normal.z.to_double() * p.z.to_double());
+  h.offset = h.offset + ExactN(std::ldexp(sign * size, -bits));
+  hs.push_back(h);
+  const double big =
+      std::max({std::abs(p.x.to_double()), std::abs(p.y.to_double()), std::abs(p.z.to_double())});
+  const ExactN t(std::ldexp(sign * big, -bits));
+  q = {p.x + t * ExactN(0.3), p.y + t * ExactN(0.3), p.z + t * ExactN(0.9 + 0x1p-30)};
+  for (const HalfSpace& g :
+       three_through({0.9, -0.2, 0.3}, {0.1, 0.8, -0.4}, {-0.5, 0.2, 0.9}, q, q_scale))
+    hs.push_back(g);
+  return hs;
+}
+
+}  // namespace
+
 // The precise stage of side and compare_along: exact zeros (a fourth plane through the
 // vertex, two vertices on one plane parallel to the fourth) stay undecided, and every
 // sign it decides is the exact sign, down to moves of 2^-90 relative.
@@ -930,26 +958,9 @@ TEST_CASE("halfspace_intersection: the precise side and compare signs are exact"
     for (int scale : {0, -200, 200}) {
       for (int bits : {20, 60, 90, 120}) {
         for (int sign : {1, -1}) {
-          std::vector<HalfSpace> hs =
-              three_through({1, 0.25, -0.5}, {-0.3, 1, 0.1}, {0.2, -0.7, 1}, p, scale);
-          // The fourth plane through p, moved by 2^-bits of the magnitude of <n, p>.
-          HalfSpace h = plane_through({0.3, 0.3, 0.9 + 0x1p-30}, p, scale);
-          const double size = std::abs(h.normal.x.to_double() * p.x.to_double()) +
-                              std::abs(h.normal.y.to_double() * p.y.to_double()) +
-                              std::abs(h.normal.z.to_double() * p.z.to_double());
-          const ExactN move(std::ldexp(sign * size, -bits));
-          h.offset = h.offset + move;
-          hs.push_back(h);
-          // v: p moved along the fourth plane's normal times 2^-bits of p's size (the
-          // sign of <n, u - v> is -sign), through three other planes.
-          const double big = std::max(
-              {std::abs(p.x.to_double()), std::abs(p.y.to_double()), std::abs(p.z.to_double())});
-          const ExactN t(std::ldexp(sign * big, -bits));
-          const V3<ExactN> q{p.x + t * ExactN(0.3), p.y + t * ExactN(0.3),
-                             p.z + t * ExactN(0.9 + 0x1p-30)};
-          for (const HalfSpace& g :
-               three_through({0.9, -0.2, 0.3}, {0.1, 0.8, -0.4}, {-0.5, 0.2, 0.9}, q, -scale))
-            hs.push_back(g);
+          V3<ExactN> q;
+          std::vector<HalfSpace> hs = moved_fourth(p, scale, -scale, bits, sign, q);
+          const HalfSpace h = hs[3];
           const PreciseProbe probe = probe_precise(hs);
           const int want_side = CGAL::sign(dot(h.normal, p) - h.offset);
           const int want_compare = CGAL::sign(dot(h.normal, p) - dot(h.normal, q));
@@ -995,22 +1006,9 @@ TEST_CASE("halfspace_intersection: the double filter's signs are exact") {
     for (int scale : {0, -350, 50, 61}) {
       for (int bits : {4, 12, 20, 40, 60, 90}) {
         for (int sign : {1, -1}) {
-          std::vector<HalfSpace> hs =
-              three_through({1, 0.25, -0.5}, {-0.3, 1, 0.1}, {0.2, -0.7, 1}, p, scale);
-          HalfSpace h = plane_through({0.3, 0.3, 0.9 + 0x1p-30}, p, scale);
-          const double size = std::abs(h.normal.x.to_double() * p.x.to_double()) +
-                              std::abs(h.normal.y.to_double() * p.y.to_double()) +
-                              std::abs(h.normal.z.to_double() * p.z.to_double());
-          h.offset = h.offset + ExactN(std::ldexp(sign * size, -bits));
-          hs.push_back(h);
-          const double big = std::max(
-              {std::abs(p.x.to_double()), std::abs(p.y.to_double()), std::abs(p.z.to_double())});
-          const ExactN t(std::ldexp(sign * big, -bits));
-          const V3<ExactN> q{p.x + t * ExactN(0.3), p.y + t * ExactN(0.3),
-                             p.z + t * ExactN(0.9 + 0x1p-30)};
-          for (const HalfSpace& g :
-               three_through({0.9, -0.2, 0.3}, {0.1, 0.8, -0.4}, {-0.5, 0.2, 0.9}, q, scale))
-            hs.push_back(g);
+          V3<ExactN> q;
+          const std::vector<HalfSpace> hs = moved_fourth(p, scale, scale, bits, sign, q);
+          const HalfSpace& h = hs[3];
           V3<ExactN> Xu, Xv;
           ExactN Wu, Wv;
           exact_meet(hs, 0, Xu, Wu);
@@ -1025,6 +1023,8 @@ TEST_CASE("halfspace_intersection: the double filter's signs are exact") {
           if (scale == 61) CHECK(probe.w == 2);  // out of range: left to the intervals
           // In range, far from degenerate: decided (p of moderate size, no underflow).
           const double small = std::min(
+              {std::abs(p.x.to_double()), std::abs(p.y.to_double()), std::abs(p.z.to_double())});
+          const double big = std::max(
               {std::abs(p.x.to_double()), std::abs(p.y.to_double()), std::abs(p.z.to_double())});
           if (scale == 0 && small > 1e-4 && big < 1e6 && bits <= 12) {
             ++expected;

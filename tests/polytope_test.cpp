@@ -467,6 +467,26 @@ TEST_CASE("polytope: make_operand's one-pass check gives the check's verdicts") 
   }
 }
 
+namespace {
+
+// The unit cube in triangles with vertex 0 moved by eps along -z: its bottom quad 0-2-3-1,
+// split along 0-3, bends outwards along 0-3 (a strictly convex ridge) for eps > 0, inwards (a
+// valley) for eps < 0; the side faces stay in their planes.
+Mesh bent_cube(double eps) {
+  std::vector<Point> points;
+  for (int i = 0; i < 8; ++i) points.push_back(Point(i & 1, (i >> 1) & 1, (i >> 2) & 1));
+  points[0][2] = -eps;
+  std::vector<std::vector<int>> triangles;
+  for (const auto& q : std::vector<std::vector<int>>{
+           {0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}}) {
+    triangles.push_back({q[0], q[1], q[2]});
+    triangles.push_back({q[0], q[2], q[3]});
+  }
+  return morph::test::mesh_from_polygons(points, triangles);
+}
+
+}  // namespace
+
 TEST_CASE("polytope: two triangles a hair from coplanar stay apart when convex, merge when not") {
   // The unit cube in triangles; its bottom quad 0-2-3-1 (z = 0) is split along 0-3. Moving
   // vertex 0 by eps along -z keeps its side faces in their planes and bends the bottom
@@ -475,16 +495,7 @@ TEST_CASE("polytope: two triangles a hair from coplanar stay apart when convex, 
   // larger bend is decided in double, the smaller one needs the exact fallback.
   for (const double eps : {0x1p-45, 0x1p-60, -0x1p-45, -0x1p-60}) {
     CAPTURE(eps);
-    std::vector<Point> points;
-    for (int i = 0; i < 8; ++i) points.push_back(Point(i & 1, (i >> 1) & 1, (i >> 2) & 1));
-    points[0][2] = -eps;
-    std::vector<std::vector<int>> triangles;
-    for (const auto& q : std::vector<std::vector<int>>{
-             {0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}}) {
-      triangles.push_back({q[0], q[1], q[2]});
-      triangles.push_back({q[0], q[2], q[3]});
-    }
-    const Mesh mesh = morph::test::mesh_from_polygons(points, triangles);
+    const Mesh mesh = bent_cube(eps);
     REQUIRE(morph::check_convex_polyhedron(mesh).ok());
     const Polytope p = morph::detail::make_operand(mesh, "A");
     CHECK(p.num_faces() == (eps > 0 ? 7 : 6));
@@ -574,17 +585,7 @@ TEST_CASE("polytope: the operand check proves edges strictly convex only when th
   // (The ridge of eps = 2^-60 is strictly convex, too shallow for the heights to tell.)
   for (const double eps : {-0x1p-45, -0x1p-60, 0x1p-60}) {
     CAPTURE(eps);
-    std::vector<Point> points;
-    for (int i = 0; i < 8; ++i) points.push_back(Point(i & 1, (i >> 1) & 1, (i >> 2) & 1));
-    points[0][2] = -eps;
-    std::vector<std::vector<int>> triangles;
-    for (const auto& q : std::vector<std::vector<int>>{
-             {0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}}) {
-      triangles.push_back({q[0], q[1], q[2]});
-      triangles.push_back({q[0], q[2], q[3]});
-    }
-    check_edge_proof(morph::test::mesh_from_polygons(points, triangles), "bent cube",
-                     eps < 0 ? Proof::not_given : Proof::either);
+    check_edge_proof(bent_cube(eps), "bent cube", eps < 0 ? Proof::not_given : Proof::either);
   }
   // A quadrilateral anywhere: left to is_canonical.
   check_edge_proof(morph::test::cube(2.0), "cube", Proof::not_given);

@@ -246,31 +246,10 @@ namespace {
 
 thread_local NearPairs* near_pairs = nullptr;
 
-/// N_x x N_y times a positive factor, as doubles w within eps of it: the double-double cross
-/// product of x's and y's precise normals, as precise_cross in polytope.cpp (the same
-/// operations and bounds; see there). False when a precise normal is not valid.
+/// precise_cross (polytope.cpp) in round-to-nearest.
 bool near_cross(const NormalRef& x, const NormalRef& y, double w[3], double& eps) {
   CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
-  const PreciseNormal& X = x.polytope->precise_normal(x.face);
-  const PreciseNormal& Y = y.polytope->precise_normal(y.face);
-  if (!X.valid || !Y.valid) return false;
-  auto dd = [](const PreciseNormal& n, int i) { return DD{n.hi[i], n.lo[i]}; };
-  auto length = [](const PreciseNormal& n) {
-    return (std::abs(n.hi[0]) + std::abs(n.hi[1]) + std::abs(n.hi[2])) * (1 + 1e-15) + n.error[0] +
-           n.error[1] + n.error[2];
-  };
-  auto error = [](const PreciseNormal& n) { return n.error[0] + n.error[1] + n.error[2]; };
-  eps = 0;
-  for (int i = 0; i < 3; ++i) {
-    const int j = (i + 1) % 3, l = (i + 2) % 3;
-    const DD c = dd(X, j) * dd(Y, l) - dd(X, l) * dd(Y, j);
-    const double magnitude =
-        std::abs(X.hi[j]) * std::abs(Y.hi[l]) + std::abs(X.hi[l]) * std::abs(Y.hi[j]);
-    w[i] = c.hi;
-    eps += 32 * kU2 * magnitude * 1.01 + 0x1p-1000 + std::abs(c.lo);
-  }
-  eps += error(X) * length(Y) + length(X) * error(Y);
-  return true;
+  return precise_cross(x, y, w, eps);
 }
 
 /// Sign of det(a, b, c), or kUndecided: orient_normals_precise's first stage (orient_near_pair

@@ -302,6 +302,8 @@ bool component_surely_zero(const Polytope& P, int f, int i) {
   return projection_degenerate(P.points[c[0]], P.points[c[1]], P.points[c[2]], i);
 }
 
+}  // namespace
+
 /// N_x x N_y for a nearly parallel pair x, y, times a positive factor, as doubles w with a
 /// bound eps on their (Euclidean) distance to it: the cross product in double-double of x's and
 /// y's precise normals. False when a precise normal is not valid. Round-to-nearest (the
@@ -330,6 +332,8 @@ bool precise_cross(const NormalRef& x, const NormalRef& y, double w[3], double& 
   eps += error_bound(X) * length_bound(Y) + length_bound(X) * error_bound(Y);
   return true;
 }
+
+namespace {
 
 /// Sign of z . (N_x x N_y) for a nearly parallel pair x, y (or kUndecided): precise_cross,
 /// dotted in doubles with z's unit normal. The far normal z needs no precise normal:

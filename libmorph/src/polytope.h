@@ -277,6 +277,10 @@ int cross_dot_normals_precise(const NormalRef& a, const NormalRef& b, const Norm
                               const NormalRef& d);
 int cross_dot_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef& c,
                             const NormalRef& d);
+/// The nearly parallel pair's stage: N_x x N_y times a positive factor, as doubles w within
+/// eps (Euclidean) of it, from the double-double cross product of x's and y's precise normals;
+/// false when a precise normal is not valid. Needs round-to-nearest (the caller's guard).
+bool precise_cross(const NormalRef& x, const NormalRef& y, double w[3], double& eps);
 
 /// The double filter of orient_normals alone: the sign, or kUndecided.
 inline int orient_normals_filter(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
