@@ -510,7 +510,10 @@ namespace {
 // its reflex test (validate.cpp, StrictBelow), and the build then skips is_canonical()'s test of
 // the edges: the proof must hold exactly whenever it is given, and never be given for a flat
 // or reflex edge. Whether geometry_passes gives it, on the mesh's own face cycles.
-bool edges_proven(const Mesh& mesh) {
+struct FastGeometry {
+  bool passes, complete, convex;
+};
+FastGeometry fast_geometry(const Mesh& mesh) {
   std::vector<int> begin{0}, vertex, across;
   for (auto f : mesh.faces()) {
     const auto h0 = mesh.halfedge_handle(f);
@@ -523,11 +526,20 @@ bool edges_proven(const Mesh& mesh) {
     begin.push_back(static_cast<int>(vertex.size()));
   }
   std::vector<morph::detail::UnitNormal> unit(mesh.n_faces());
-  bool complete = false, convex = false;
-  const bool passes = morph::detail::geometry_passes(
-      mesh, {begin.data(), vertex.data(), across.data()}, unit.data(), complete, convex);
-  return passes && complete && convex;
+  FastGeometry g{false, false, false};
+  g.passes = morph::detail::geometry_passes(mesh, {begin.data(), vertex.data(), across.data()},
+                                            unit.data(), g.complete, g.convex);
+  return g;
 }
+
+bool edges_proven(const Mesh& mesh) {
+  const FastGeometry g = fast_geometry(mesh);
+  return g.passes && g.complete && g.convex;
+}
+
+// geometry_passes' verdict with the unit normals (make_operand's sequential check, with the
+// proof of the edges and its shortcuts).
+bool geometry_check_passes(const Mesh& mesh) { return fast_geometry(mesh).passes; }
 
 // Whether every edge of a triangle mesh is strictly convex, decided exactly as is_canonical()
 // defines it: det(N_left, N_right, to - from) > 0 for the exact normals of the two triangles.
@@ -595,6 +607,65 @@ TEST_CASE("polytope: the operand check proves edges strictly convex only when th
     if (proven) CHECK(exactly_strictly_convex(random));
     check_both_paths(random, "sphere " + std::to_string(seed));
   }
+}
+
+TEST_CASE("polytope: the check's shortcut past proven edges keeps its verdict near the tolerance") {
+  // While every edge so far is proven strictly convex, a triangle skips the reflex test of an
+  // edge to an earlier triangle (which proved it). Each vertex moved to c + t (p - c), c the
+  // centroid of its neighbours and t = +-2^-k, lies a hair above or below them: its edges turn
+  // slightly convex or reflex, across the tolerance both ways (on irregular triangles too), and
+  // geometry_passes' verdict must be the full check's.
+  std::vector<std::pair<Mesh, std::string>> meshes;
+  meshes.emplace_back(morph::read_mesh(std::string(MORPH_SAMPLES_DIR) + "/icosphere_80.off"),
+                      "icosphere");
+  for (std::uint64_t seed = 1; seed <= 2; ++seed)
+    meshes.emplace_back(morph::test::random_sphere_polytope(30, seed),
+                        "sphere " + std::to_string(seed));
+  int rejected = 0, accepted = 0;
+  for (const auto& [mesh, name] : meshes) {
+    for (auto f : mesh.faces()) REQUIRE(mesh.valence(f) == 3);
+    REQUIRE(edges_proven(mesh));
+    for (auto v : mesh.vertices())
+      for (int k = 8; k <= 40; ++k)
+        for (const double sign : {1.0, -1.0, 1.4, -1.4}) {
+          Point c(0, 0, 0);
+          int n = 0;
+          for (auto w : mesh.vv_range(v)) c += mesh.point(w), ++n;
+          c /= n;
+          Mesh moved = mesh;
+          moved.set_point(v, c + (mesh.point(v) - c) * (sign * std::ldexp(1.0, -k)));
+          CAPTURE(name);
+          CAPTURE(v.idx());
+          CAPTURE(k);
+          CAPTURE(sign);
+          const bool expected = morph::check_convex_polyhedron(moved).ok();
+          CHECK(geometry_check_passes(moved) == expected);
+          (expected ? accepted : rejected) += 1;
+        }
+  }
+  // One reflex edge, told by one side only: the base of a pyramid folded along its diagonal A-C
+  // by lowering B (outwards) by delta; the far corner D lies five times as far from A-C as B, so
+  // the test from triangle ACB sees D 5 delta above its plane, the test from ADC sees B delta
+  // above: with delta below the tolerance (about 4.4e-9 here) and 5 delta above it, only ACB's
+  // test rejects the mesh, whichever of the two triangles comes first.
+  for (const double delta : {0.4e-9, 1e-9, 2e-9, 3e-9, 6e-9}) {
+    const std::vector<Point> points = {
+        {0, 0, 0}, {1, 0, -delta}, {1, 1, 0}, {-2, 3, 0}, {0, 1.2, 1}};
+    const std::vector<int> acb = {0, 2, 1}, adc = {0, 3, 2};
+    const std::vector<std::vector<int>> sides = {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
+    for (const bool acb_first : {false, true}) {
+      std::vector<std::vector<int>> faces = {acb_first ? acb : adc, acb_first ? adc : acb};
+      faces.insert(faces.end(), sides.begin(), sides.end());
+      const Mesh pyramid = morph::test::mesh_from_polygons(points, faces);
+      CAPTURE(delta);
+      CAPTURE(acb_first);
+      const bool expected = morph::check_convex_polyhedron(pyramid).ok();
+      CHECK(geometry_check_passes(pyramid) == expected);
+      (expected ? accepted : rejected) += 1;
+    }
+  }
+  CHECK(rejected > 0);  // both verdicts occur: the comparison is not vacuous
+  CHECK(accepted > 0);
 }
 
 namespace {

@@ -822,14 +822,11 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   const bool reversed = order == FaceOrder::reversed;
   // Corner c is a halfedge of its face: leaving the corner's vertex when as given; when
   // reversed, entering it (the facet runs against the halfedges). What the walks know of
-  // mesh edge h / 2 (OpenMesh stores the two halfedges of edge e as 2e and 2e + 1):
-  // kUnwalked, 2 c + (h & 1) once corner c of halfedge h has met it (below kWalked: c < nh
-  // fits an int), kWalked once both have.
-  constexpr unsigned kUnwalked = ~0u, kWalked = ~0u - 1;
-  std::vector<unsigned> edge_state(nh / 2, kUnwalked);
-  // twin[c]: the corner of the other facet on c's edge. Written before it is read (as
-  // `link` below): left uninitialised.
-  std::unique_ptr<int[]> twin(new int[nh]);
+  // mesh edge h / 2 (OpenMesh stores the two halfedges of edge e as 2e and 2e + 1), in its
+  // two low bits: 0 unwalked, 1 + (h & 1) once the corner of halfedge h has met it, 3 once
+  // both have; above them, the polytope edge once it has one (below 2^30: at most nh / 2).
+  constexpr unsigned kWalked = 3;
+  std::vector<unsigned> edge_state(nh / 2, 0);
   p.face_begin.resize(nf + 1);
   p.corner_vertex.resize(nh);
   p.corner_edge.resize(nh);
@@ -840,11 +837,12 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   int* const corner_vertex = p.corner_vertex.data();
   int* const corner_edge = p.corner_edge.data();
   Polytope::Edge* const edges = p.edges.data();
-  // The last corner at each vertex, where its fan starts.
-  std::vector<int> some_corner(nv, -1);
+  // Where the fan of each vertex starts: at its last corner, as the halfedge its fan slot reads
+  // (see the fan walk below).
+  std::vector<int> some_slot(nv, -1);
   const HalfedgeArrays arrays(mesh);
-  // The checked path's findings: whether every halfedge names the face whose cycle holds
-  // it and its opposite ends at the corner's vertex (the check reads both), and `across`.
+  // The checked path's findings: whether every halfedge's opposite ends at the corner's vertex
+  // (the check reads it), and `across`.
   bool consistent = true;
   int* across = nullptr;
   if (topology) {
@@ -854,7 +852,9 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   }
   // One walk around each face: its corners, and each edge as its first corner meets it
   // (the edge's from, left facet and mesh edge) and completed at its second (to, right
-  // facet, and the two corners as each other's twin).
+  // facet). The walk follows next links (prev when reversed); each halfedge must name the
+  // face and link back to the one before (the fan walk follows the other links and the faces
+  // of halfedges).
   int c = 0, e = 0;
   for (int f = 0; f < nf; ++f) {
     const int begin = c;
@@ -864,39 +864,38 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
     // target of the halfedge before it (read with the link to the next one).
     const int start = reversed ? arrays.prev(h0) : arrays.next(h0);
     int from = arrays.to(h0);
-    int entering = h0;  // the halfedge that ends at the corner (as given)
+    int previous = h0;  // the halfedge walked before h (as given: it ends at the corner)
     int h = start;
     do {
       // Each halfedge once (its edge not walked, or walked by the other halfedge only):
       // with the count below, every halfedge is some face's.
       unsigned& state = edge_state[h >> 1];
-      if (c == nh || state == kWalked || (state != kUnwalked && (state & 1) == (h & 1u)))
+      const unsigned walked = state & 3u;
+      if (c == nh || walked == kWalked || (walked != 0 && walked - 1 == (h & 1u)) ||
+          arrays.face(h) != f || (reversed ? arrays.next(h) : arrays.prev(h)) != previous)
         throw error("internal error: a mesh face is not a closed cycle");
       const int vertex = reversed ? arrays.to(h) : from;
       corner_vertex[c] = vertex;
-      some_corner[vertex] = c;
+      some_slot[vertex] = previous;
       int edge;
-      if (state == kUnwalked) {  // the edge's first corner
-        state = 2u * c + (h & 1u);
+      if (walked == 0) {  // the edge's first corner
         edge = e++;
+        state = (static_cast<unsigned>(edge) << 2) | (1u + (h & 1u));
         edges[edge].from = vertex;
         edges[edge].left = f;
         mesh_edge[edge] = h >> 1;
       } else {
-        const int t = static_cast<int>(state >> 1);
-        state = kWalked;
-        edge = corner_edge[t];
+        edge = static_cast<int>(state >> 2);
+        state |= kWalked;
         edges[edge].to = vertex;
         edges[edge].right = f;
-        twin[t] = c;
-        twin[c] = t;
       }
       corner_edge[c] = edge;
       if (topology) {
-        across[c] = arrays.face(entering ^ 1);
-        consistent &= (arrays.face(h) == f) & (arrays.to(h ^ 1) == from);
-        entering = h;
+        across[c] = arrays.face(previous ^ 1);
+        consistent &= arrays.to(h ^ 1) == from;
       }
+      previous = h;
       ++c;
       if (!reversed) from = arrays.to(h);
       h = reversed ? arrays.prev(h) : arrays.next(h);
@@ -905,22 +904,8 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   p.face_begin[nf] = c;
   if (c != nh) throw error("internal error: a mesh halfedge has no face");
   // Every halfedge has been walked once, so each edge's two corners have both been met: e is
-  // nh / 2, and every corner has its twin.
+  // nh / 2, and every edge state holds its polytope edge.
   const int nc = c;
-  // What the fan walk reads at corner c, together, so that each step is one load: its facet,
-  // the previous corner's vertex and edge (the slot from c's vertex to it), and the next
-  // corner counter-clockwise around c's vertex: from facet f at v, the next facet is the
-  // one across f's incoming edge u -> v, at the twin of the previous corner (as
-  // build_connectivity walks them).
-  struct FanLink {
-    int face, prev_vertex, prev_edge, next;
-  };
-  std::unique_ptr<FanLink[]> link(new FanLink[nc]);
-  for (int f = 0; f < nf; ++f) {
-    const int begin = p.face_begin[f], end = p.face_begin[f + 1];
-    for (int k = begin, prev = end - 1; k < end; prev = k++)
-      link[k] = {f, corner_vertex[prev], corner_edge[prev], twin[prev]};
-  }
   p.fan_begin.resize(nv + 1);
   p.fan_face.resize(nc);
   p.fan_edge.resize(nc);
@@ -932,28 +917,32 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   // The checked path: the vertex whose fan last reached each vertex (a neighbour reached
   // twice means two edges between the same vertices).
   std::vector<int> seen(topology ? nv : 0, -1);
+  // The fans as build_connectivity walks them (from facet f at v, the next facet is the one
+  // across f's incoming edge u -> v), read straight off the halfedges: the slot of a corner at
+  // v is, as given, the halfedge g = u -> v of its face (the face, u = to(g ^ 1), the edge),
+  // the next slot prev(g ^ 1); reversed, the halfedge o = v -> u of its face (u = to(o)), the
+  // next slot next(o ^ 1). Each step reads one mesh edge's record and its state.
   for (int v = 0; v < nv; ++v) {
     p.fan_begin[v] = slot;
-    const int first = some_corner[v];
+    const int first = some_slot[v];
     if (first < 0) {
       consistent = false;  // isolated
       continue;
     }
-    c = first;
+    int g = first;
     do {
       if (slot == nc) throw error("internal error: a mesh vertex has a broken fan");
-      const FanLink& l = link[c];
-      fan_face[slot] = l.face;
-      fan_edge[slot] = l.prev_edge;
-      const int w = l.prev_vertex;
+      fan_face[slot] = arrays.face(g);
+      fan_edge[slot] = static_cast<int>(edge_state[g >> 1] >> 2);
+      const int w = reversed ? arrays.to(g) : arrays.to(g ^ 1);
       fan_vertex[slot] = w;
       if (topology) {
         consistent &= seen[w] != v;
         seen[w] = v;
       }
       ++slot;
-      c = l.next;
-    } while (c != first);
+      g = reversed ? arrays.next(g ^ 1) : arrays.prev(g ^ 1);
+    } while (g != first);
   }
   p.fan_begin[nv] = slot;
   if (slot != nc) throw error("internal error: a mesh vertex has several fans");

@@ -379,8 +379,10 @@ struct StrictBelow {
 // out of that function's range: the caller then computes every unit normal itself.
 inline void unit_normal(detail::UnitNormal& out, double nx, double ny, double nz, double length,
                         double inverse, double magnitude, int d, bool& complete) {
-  if (!detail::centroid_unit_normal(nx, ny, nz, length, inverse, magnitude, d, out))
+  if (!detail::centroid_unit_normal(nx, ny, nz, length, inverse, magnitude, d, out)) {
     complete = false;
+    out.error = std::numeric_limits<double>::infinity();  // proves nothing (see StrictBelow)
+  }
 }
 
 using detail::norm1;
@@ -541,8 +543,14 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, const S
   const int from[3] = {i2, i0, i1}, to[3] = {i0, i1, i2};
   bool reflex = false, polygon_across = false, below = true;
   const double threshold = kProve && proven ? strict.threshold(unit[f].error) : 0;
+  // While every edge met so far is proven, an edge to an earlier face g was proven by g's heights
+  // (a triangle, as every face so far): strictly convex, so the far corner v of g lies strictly
+  // below f's exact plane and its height here is below e_f W + K = -threshold (StrictBelow's
+  // bound); when that is within the tolerance, the reflex test would pass and is skipped.
+  const bool skip_earlier = kProve && proven && -threshold <= tolerance;
   for (int k = 0; k < 3; ++k) {
     const int g = across[k];
+    if (skip_earlier && g < f) continue;
     const int gb = cycles.begin[g];
     if (cycles.begin[g + 1] - gb != 3) {
       polygon_across = true;
