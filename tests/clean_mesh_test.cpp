@@ -688,3 +688,43 @@ TEST_CASE("index_vertices numbers a vertex with many partners, listed by either 
     check_numbering(facets, num_a, num_b, expected);
   }
 }
+
+// Facets of one degree that follow each other have their planes found two at a time (one
+// in each lane of a vector): a box whose top is split along x = 1/2 into two halves that
+// follow each other, as quadrilaterals or as two triangles each, merge when they are flat
+// and stay apart when their ridge is raised (the midpoints 8 = (1/2,0,1+h), 9 = (1/2,1,1+h)
+// are corners of the front and back facets too, which stay planar).
+TEST_CASE("clean_mesh finds the planes of consecutive facets two at a time") {
+  for (const bool triangles : {false, true})
+    for (const double h : {0.0, 0.01}) {
+      CAPTURE(triangles);
+      CAPTURE(h);
+      std::vector<V3<double>> points = cube_points();
+      points.push_back({0.5, 0, 1 + h});
+      points.push_back({0.5, 1, 1 + h});
+      std::vector<std::vector<int>> facets;
+      if (triangles)
+        facets = {{4, 8, 9}, {4, 9, 6}, {8, 5, 7}, {8, 7, 9}};
+      else
+        facets = {{4, 8, 9, 6}, {8, 5, 7, 9}};
+      for (const std::vector<int>& f : std::vector<std::vector<int>>{
+               {0, 1, 5, 8, 4}, {2, 6, 9, 7, 3}, {0, 2, 3, 1}, {0, 4, 6, 2}, {1, 3, 7, 5}})
+        facets.push_back(f);
+      std::vector<int> begin{0}, corners;
+      for (const auto& f : facets) {
+        corners.insert(corners.end(), f.begin(), f.end());
+        begin.push_back(static_cast<int>(corners.size()));
+      }
+      const morph::Mesh mesh = clean_mesh(points, begin, corners, nullptr);
+      if (h == 0) {
+        check_cube(mesh);
+        continue;
+      }
+      // The roof's two slopes (each one polygon), the front and back pentagons, three squares.
+      CHECK(mesh.n_vertices() == 10);
+      REQUIRE(mesh.n_faces() == 7);
+      std::multiset<std::size_t> valences;
+      for (auto f : mesh.faces()) valences.insert(mesh.valence(f));
+      CHECK(valences == std::multiset<std::size_t>{4, 4, 4, 4, 4, 5, 5});
+    }
+}

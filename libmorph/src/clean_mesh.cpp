@@ -226,23 +226,22 @@ Pair pair_sqrt(Pair x) {
 #endif
 }
 
-/// `Degree`: the facet's, when known (0: read from the soup); its loop is then unrolled.
-template <int Degree = 0>
-FacetGeometry geometry(const std::vector<V3<double>>& points, const Soup& soup, int f) {
+/// std::max(a, b) (b if a < b, else a: the same for zeros of either sign and NaNs) in one
+/// instruction, never a branch (which of a facet's edges is the longest is irregular).
+double max_of(double a, double b) {
+#if defined(__SSE2__)
+  return _mm_cvtsd_f64(_mm_max_sd(_mm_set_sd(b), _mm_set_sd(a)));  // b > a ? b : a
+#else
+  return std::max(a, b);
+#endif
+}
+
+/// A facet's geometry from its first corner (`origin`), Newell's normal (`sum`, twice the
+/// vector area), the sum of its corners' offsets from the origin, its longest squared edge
+/// and its degree.
+FacetGeometry finish_geometry(const V3<double>& origin, const V3<double>& sum, V3<double> centroid,
+                              double longest_squared, int d) {
   FacetGeometry g{};  // zeros
-  const int b = soup.begin[f], d = Degree > 0 ? Degree : soup.degree(f);
-  const V3<double>& origin = points[soup.vertex[b]];
-  V3<double> sum{0, 0, 0}, centroid{0, 0, 0};
-  double longest_squared = 0;  // the root is monotonic: the root of the maximum is the maximum root
-  V3<double> p{0, 0, 0};       // the corner's offset from the origin (each computed once)
-  for (int k = 0; k < d; ++k) {
-    const V3<double> q = k + 1 == d ? V3<double>{0, 0, 0} : points[soup.vertex[b + k + 1]] - origin;
-    sum = sum + cross(p, q);  // Newell's normal (twice the vector area)
-    const V3<double> e = q - p;
-    longest_squared = std::max(longest_squared, dot(e, e));
-    centroid = centroid + p;
-    p = q;
-  }
   // Both roots in one instruction and the six divisions in three, two lanes at a time: a
   // lane of a packed root or quotient is the scalar one (IEEE), and the unit that does them
   // takes as long for two lanes as for one (they were most of this function's time).
@@ -266,6 +265,137 @@ FacetGeometry geometry(const std::vector<V3<double>>& points, const Soup& soup, 
     g.offset = dot(g.normal, centroid);
   }
   return g;
+}
+
+/// Any facet's geometry: Newell's sums about its first corner.
+FacetGeometry geometry(const std::vector<V3<double>>& points, const Soup& soup, int f) {
+  const int b = soup.begin[f], d = soup.degree(f);
+  const V3<double>& origin = points[soup.vertex[b]];
+  V3<double> sum{0, 0, 0}, centroid{0, 0, 0};
+  double longest_squared = 0;  // the root is monotonic: the root of the maximum is the maximum root
+  V3<double> p{0, 0, 0};       // the corner's offset from the origin (each computed once)
+  for (int k = 0; k < d; ++k) {
+    const V3<double> q = k + 1 == d ? V3<double>{0, 0, 0} : points[soup.vertex[b + k + 1]] - origin;
+    sum = sum + cross(p, q);  // Newell's normal (twice the vector area)
+    const V3<double> e = q - p;
+    longest_squared = max_of(longest_squared, dot(e, e));
+    centroid = centroid + p;
+    p = q;
+  }
+  return finish_geometry(origin, sum, centroid, longest_squared, d);
+}
+
+/// v + 0 componentwise: v, with zeros made positive (as 0 + v, which `geometry`'s sums start
+/// with).
+V3<double> plus_zero(const V3<double>& v) { return {v.x + 0.0, v.y + 0.0, v.z + 0.0}; }
+
+/// The finite limit that the sums' checks below compare with (NaN and infinities fail).
+constexpr double kLargest = std::numeric_limits<double>::max();
+
+/// `geometry` of a triangle, without its terms known to be zeros. In `geometry`, the first
+/// and last cross products have a zero vector as a factor: with finite offsets q1, q2 of the
+/// corners, they are zeros of either sign, and the sum is 0 + cross(q1, q2) (adding a zero
+/// to a sum that is not -0 changes nothing); the offsets' sum is 0 + q1 + q2, and the last
+/// edge, 0 - q2, has the squares of q2. A component of cross(q1, q2) is a difference of
+/// products of every component of q1 and q2: finite only when they are, so a sum that is
+/// not finite (or whose squares overflow) takes `geometry` itself. (The same values, but
+/// for the signs of NaNs, which no comparison reads.)
+FacetGeometry triangle_geometry(const std::vector<V3<double>>& points, const Soup& soup, int f) {
+  const int* const v = soup.vertex.data() + soup.begin[f];
+  const V3<double>& origin = points[v[0]];
+  const V3<double> q1 = points[v[1]] - origin, q2 = points[v[2]] - origin;
+  const V3<double> sum = plus_zero(cross(q1, q2));
+  if (!(dot(sum, sum) <= kLargest)) return geometry(points, soup, f);
+  const V3<double> e = q2 - q1;
+  const double longest_squared = max_of(max_of(max_of(0.0, dot(q1, q1)), dot(e, e)), dot(q2, q2));
+  return finish_geometry(origin, sum, plus_zero(q1) + q2, longest_squared, 3);
+}
+
+/// `geometry` of a quadrilateral, as triangle_geometry: the sum is (0 + cross(q1, q2)) +
+/// cross(q2, q3) (not -0: a sum is -0 only of two -0), finite only when both terms are.
+FacetGeometry quad_geometry(const std::vector<V3<double>>& points, const Soup& soup, int f) {
+  const int* const v = soup.vertex.data() + soup.begin[f];
+  const V3<double>& origin = points[v[0]];
+  const V3<double> q1 = points[v[1]] - origin, q2 = points[v[2]] - origin,
+                   q3 = points[v[3]] - origin;
+  const V3<double> sum = plus_zero(cross(q1, q2)) + cross(q2, q3);
+  if (!(dot(sum, sum) <= kLargest)) return geometry(points, soup, f);
+  const V3<double> e1 = q2 - q1, e2 = q3 - q2;
+  const double longest_squared =
+      max_of(max_of(max_of(max_of(0.0, dot(q1, q1)), dot(e1, e1)), dot(e2, e2)), dot(q3, q3));
+  return finish_geometry(origin, sum, (plus_zero(q1) + q2) + q3, longest_squared, 4);
+}
+
+/// std::max per lane (max_of in each).
+Pair pair_max(Pair a, Pair b) {
+#if defined(__SSE2__)
+  return _mm_max_pd(b, a);  // b > a ? b : a, lane by lane
+#else
+  return Pair{max_of(a[0], b[0]), max_of(a[1], b[1])};
+#endif
+}
+
+/// triangle_geometry (Degree 3) or quad_geometry (4) of facets f and f + 1 at once, one in
+/// each lane: each lane's operations are those of the one-facet function (a lane of a
+/// packed operation is the scalar one, IEEE), in about half the instructions. A lane whose
+/// facet has no area is given zeros as the one-facet function would (its quotients are
+/// not used); a sum that is not finite takes the one-facet functions.
+template <int Degree>
+void geometry_pair(const std::vector<V3<double>>& points, const Soup& soup, int f,
+                   FacetGeometry* geo) {
+  const int* const v = soup.vertex.data() + soup.begin[f];
+  const int* const w = v + Degree;  // facet f + 1's corners follow f's
+  const auto load = [&](int k) {
+    const V3<double>&p = points[v[k]], &q = points[w[k]];
+    return V3<Pair>{Pair{p.x, q.x}, Pair{p.y, q.y}, Pair{p.z, q.z}};
+  };
+  const Pair zero{0, 0};
+  const auto plus_zero = [&](const V3<Pair>& a) {
+    return V3<Pair>{a.x + zero, a.y + zero, a.z + zero};
+  };
+  const V3<Pair> origin = load(0), q1 = load(1) - origin, q2 = load(2) - origin;
+  V3<Pair> sum, centroid;
+  Pair longest_squared;
+  if constexpr (Degree == 3) {
+    sum = plus_zero(cross(q1, q2));
+    const V3<Pair> e = q2 - q1;
+    longest_squared = pair_max(pair_max(pair_max(zero, dot(q1, q1)), dot(e, e)), dot(q2, q2));
+    centroid = plus_zero(q1) + q2;
+  } else {
+    const V3<Pair> q3 = load(3) - origin;
+    sum = plus_zero(cross(q1, q2)) + cross(q2, q3);
+    const V3<Pair> e1 = q2 - q1, e2 = q3 - q2;
+    longest_squared = pair_max(
+        pair_max(pair_max(pair_max(zero, dot(q1, q1)), dot(e1, e1)), dot(e2, e2)), dot(q3, q3));
+    centroid = (plus_zero(q1) + q2) + q3;
+  }
+  const Pair squared_area = dot(sum, sum);
+  if (!(squared_area[0] <= kLargest) || !(squared_area[1] <= kLargest)) {
+    for (int g = f; g < f + 2; ++g)
+      geo[g] = Degree == 3 ? triangle_geometry(points, soup, g) : quad_geometry(points, soup, g);
+    return;
+  }
+  const Pair longest = pair_sqrt(longest_squared), area = pair_sqrt(squared_area);
+  const V3<Pair> normal{sum.x / area, sum.y / area, sum.z / area};
+  if constexpr (Degree == 3) {
+    const Pair n{3, 3};
+    centroid = {origin.x + centroid.x / n, origin.y + centroid.y / n, origin.z + centroid.z / n};
+  } else {  // x * 0.25 is x / 4, as in finish_geometry
+    const Pair quarter{0.25, 0.25};
+    centroid = {origin.x + centroid.x * quarter, origin.y + centroid.y * quarter,
+                origin.z + centroid.z * quarter};
+  }
+  const Pair offset = dot(normal, centroid);
+  for (int i = 0; i < 2; ++i) {
+    FacetGeometry& g = geo[f + i];
+    g = FacetGeometry{};  // zeros
+    g.longest_edge = longest[i];
+    g.twice_area = area[i];
+    if (g.twice_area > 0) {
+      g.normal = {normal.x[i], normal.y[i], normal.z[i]};
+      g.offset = offset[i];
+    }
+  }
 }
 
 bool is_thin(const FacetGeometry& g, double limit) {
@@ -719,12 +849,22 @@ std::optional<Connectivity> connect_with(int num_points, const Soup& soup, Merge
 void geometries(const std::vector<V3<double>>& points, const Soup& soup, FacetGeometry* geo) {
   parallel_chunks(soup.size(), kFacetGrain, [&](int first, int last) {
     // Triangles and quadrilaterals (nearly all facets, in long runs: the branch is
-    // predicted) by straight-line code: the same operations in the same order.
+    // predicted) by straight-line code: the same operations in the same order, two facets
+    // at once when two of one degree follow each other (geometry_pair: about 40% less time
+    // for the facets' geometry than one at a time).
     const int* const begin = soup.begin.data();
     for (int f = first; f < last; ++f) {
       const int d = begin[f + 1] - begin[f];
-      geo[f] = d == 3   ? geometry<3>(points, soup, f)
-               : d == 4 ? geometry<4>(points, soup, f)
+      if (f + 1 < last && begin[f + 2] - begin[f + 1] == d && (d == 3 || d == 4)) {
+        if (d == 3)
+          geometry_pair<3>(points, soup, f, geo);
+        else
+          geometry_pair<4>(points, soup, f, geo);
+        ++f;
+        continue;
+      }
+      geo[f] = d == 3   ? triangle_geometry(points, soup, f)
+               : d == 4 ? quad_geometry(points, soup, f)
                         : geometry(points, soup, f);
     }
   });
