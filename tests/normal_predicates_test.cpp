@@ -219,7 +219,7 @@ TEST_CASE("normal predicates: a region's slot planes agree with exact evaluation
     const Polytope B = morph::detail::make_operand(b, "B");
     const auto slots = morph::detail::slot_planes(B);
     REQUIRE(slots.size() == B.fan_face.size());
-    int tested = 0, decided = 0, flipped = 0;
+    int tested = 0, decided = 0, flipped = 0, not_cross = 0;
     std::vector<int> order(A.num_faces());
     for (int v = 0; v < B.num_vertices(); ++v) {
       const int begin = B.fan_begin[v], n = B.fan_begin[v + 1] - begin;
@@ -227,6 +227,11 @@ TEST_CASE("normal predicates: a region's slot planes agree with exact evaluation
         const int s = begin + i;
         const NormalRef l{&B, B.fan_face[s]}, r{&B, B.fan_face[begin + (i + 1) % n]};
         flipped += B.edges[B.fan_edge[s]].left != l.face;
+        // Each slot's plane is cross_plane of its two normals, bit for bit (the last slot's
+        // second normal is the fan's first).
+        const morph::detail::ArcPlane c = morph::detail::cross_plane(l.unit(), r.unit());
+        not_cross += !(slots[s].x == c.x && slots[s].y == c.y && slots[s].z == c.z &&
+                       slots[s].error == c.error);
         closest_three(A, l.unit(), order);
         for (int k = 0; k < 3; ++k) {
           const NormalRef x{&A, order[k]};
@@ -242,6 +247,7 @@ TEST_CASE("normal predicates: a region's slot planes agree with exact evaluation
     }
     CHECK(flipped > 0);
     CHECK(decided > 0);
+    CHECK(not_cross == 0);
     MESSAGE(tested << " slot orientations, " << decided << " decided by the filter");
   }
 }
