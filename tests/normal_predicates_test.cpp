@@ -7,8 +7,11 @@
 #include <morph/io.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <numeric>
+#include <random>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -219,7 +222,7 @@ TEST_CASE("normal predicates: a region's slot planes agree with exact evaluation
     const Polytope B = morph::detail::make_operand(b, "B");
     const auto slots = morph::detail::slot_planes(B);
     REQUIRE(slots.size() == B.fan_face.size());
-    int tested = 0, decided = 0, flipped = 0;
+    int tested = 0, decided = 0, flipped = 0, not_cross = 0;
     std::vector<int> order(A.num_faces());
     for (int v = 0; v < B.num_vertices(); ++v) {
       const int begin = B.fan_begin[v], n = B.fan_begin[v + 1] - begin;
@@ -227,6 +230,11 @@ TEST_CASE("normal predicates: a region's slot planes agree with exact evaluation
         const int s = begin + i;
         const NormalRef l{&B, B.fan_face[s]}, r{&B, B.fan_face[begin + (i + 1) % n]};
         flipped += B.edges[B.fan_edge[s]].left != l.face;
+        // Each slot's plane is cross_plane of its two normals, bit for bit (the last slot's
+        // second normal is the fan's first).
+        const morph::detail::ArcPlane c = morph::detail::cross_plane(l.unit(), r.unit());
+        not_cross += !(slots[s].x == c.x && slots[s].y == c.y && slots[s].z == c.z &&
+                       slots[s].error == c.error);
         closest_three(A, l.unit(), order);
         for (int k = 0; k < 3; ++k) {
           const NormalRef x{&A, order[k]};
@@ -242,6 +250,7 @@ TEST_CASE("normal predicates: a region's slot planes agree with exact evaluation
     }
     CHECK(flipped > 0);
     CHECK(decided > 0);
+    CHECK(not_cross == 0);
     MESSAGE(tested << " slot orientations, " << decided << " decided by the filter");
   }
 }
@@ -609,4 +618,70 @@ TEST_CASE("normal predicates: the double-double stage alone agrees with exact ev
       CHECK(tiny_decided > 0);
     }
   }
+}
+
+// two_prod takes a fused multiply-subtract where the processor has one (kHasFma): its doubles
+// must be Dekker's, bit for bit (the sign of a zero too), and hi + lo the exact product, on
+// random products over a wide range of exponents and on hard ones: significands with all
+// bits set, 26-bit halves (Dekker's split), ties of the rounding of hi, powers of two, signed
+// zeros, products near the ends of Dekker's range.
+TEST_CASE("normal predicates: two_prod with FMA is Dekker's, bit for bit") {
+  using morph::detail::DD;
+  std::mt19937_64 rng(20261124);
+  auto random_double = [&](int min_exponent, int max_exponent) {
+    const double significand = 1 + static_cast<double>(rng() >> 12) * 0x1p-52;  // 53 bits
+    const int exponent =
+        min_exponent +
+        static_cast<int>(rng() % static_cast<unsigned>(max_exponent - min_exponent + 1));
+    return std::ldexp(rng() % 2 ? -significand : significand, exponent);
+  };
+  std::vector<std::pair<double, double>> cases;
+  for (int i = 0; i < 200000; ++i)
+    cases.emplace_back(random_double(-450, 450), random_double(-450, 450));
+  const double hard[] = {0.0,
+                         -0.0,
+                         1.0,
+                         -1.0,
+                         0x1.fffffffffffffp0,
+                         -0x1.fffffffffffffp-1,
+                         1 + 0x1p-52,
+                         1 - 0x1p-53,
+                         134217729.0,  // 2^27 + 1, the split constant
+                         0x1.0000001p0,
+                         0x1.fffffffp0,
+                         0x1.8000000000001p0,
+                         0x1.5555555555555p-2,
+                         0x1p-500,
+                         0x1.fffffffffffffp-480,
+                         0x1p990,
+                         0x1.fffffffffffffp994,
+                         3.0,
+                         0.1,
+                         -0.7};
+  for (double a : hard)
+    for (double b : hard)
+      if (std::abs(a * b) < 0x1p1000 && (a * b == 0 || std::abs(a * b) > 0x1p-960))
+        cases.emplace_back(a, b);
+  // Ties: a b exactly halfway between two doubles (hi rounds to even), either side.
+  for (int k = 1; k < 2000; k += 2) {
+    const double a = 1 + k * 0x1p-27, b = 1 + (2001 - k) * 0x1p-27;
+    cases.emplace_back(a, b);
+    cases.emplace_back(-a, b);
+  }
+  int not_exact = 0, differing = 0;
+  for (const auto& [a, b] : cases) {
+    const DD d = morph::detail::two_prod_dekker(a, b);
+    not_exact += CGAL::sign(morph::detail::ExactN(d.hi) + morph::detail::ExactN(d.lo) -
+                            morph::detail::ExactN(a) * morph::detail::ExactN(b)) != CGAL::ZERO;
+    if (!morph::detail::kHasFma) continue;
+    const DD f = morph::detail::two_prod_fma(a, b), t = morph::detail::two_prod(a, b);
+    auto bits = [](double x) { return std::bit_cast<std::uint64_t>(x); };
+    differing += bits(f.hi) != bits(d.hi) || bits(f.lo) != bits(d.lo) || bits(t.hi) != bits(d.hi) ||
+                 bits(t.lo) != bits(d.lo);
+  }
+  CHECK(not_exact == 0);
+  CHECK(differing == 0);
+  const std::string compared =
+      morph::detail::kHasFma ? "FMA compared with Dekker" : "no FMA here: Dekker's only";
+  MESSAGE(cases.size() << " products; " << compared);
 }

@@ -345,16 +345,26 @@ namespace {
 /// The slot planes of v's region (its fan's consecutive facet normals), into `out`
 /// (P.fan_begin[v] onwards): slot_planes and SlotCache make the same doubles with it.
 void region_slot_planes(const Polytope& P, int v, ArcPlane* out) {
-  const int b = P.fan_begin[v], n = P.fan_begin[v + 1] - b;
-  const int* const fan = P.fan_face.data() + b;
-  for (int i = 0; i < n; ++i)
-    out[b + i] = cross_plane(P.unit_normals[fan[i]], P.unit_normals[fan[i + 1 == n ? 0 : i + 1]]);
+  // Each normal loaded once, into locals (the stores cannot alias them): every slot's second
+  // normal is the next slot's first.
+  const UnitNormal* const units = P.unit_normals.data();
+  const int* const fan = P.fan_face.data();
+  const int b = P.fan_begin[v], e = P.fan_begin[v + 1];
+  if (b == e) return;
+  const UnitNormal first = units[fan[b]];
+  UnitNormal q = first;
+  for (int s = b; s + 1 < e; ++s) {
+    const UnitNormal r = units[fan[s + 1]];
+    out[s] = cross_plane(q, r);
+    q = r;
+  }
+  out[e - 1] = cross_plane(q, first);
 }
 
 }  // namespace
 
-std::vector<ArcPlane> slot_planes(const Polytope& P) {
-  std::vector<ArcPlane> slots(P.fan_face.size());
+SlotPlanes slot_planes(const Polytope& P) {
+  SlotPlanes slots(P.fan_face.size());
   parallel_chunks(P.num_vertices(), 1024, [&](int begin, int end) {
     for (int v = begin; v < end; ++v) region_slot_planes(P, v, slots.data());
   });
@@ -480,9 +490,9 @@ std::vector<Location> locate_all(const Polytope& from, const Polytope& in,
   // A walk tests about ten slots, and forming a slot's plane costs about as much as testing
   // it: making them all first pays only when the walks are many for the slots (at least a
   // quarter as many), else each is formed as it is tested. Either way the same doubles.
-  std::vector<ArcPlane> slots;
+  SlotPlanes slots;
   if (4 * static_cast<std::size_t>(from.num_faces()) >= in.fan_face.size()) slots = slot_planes(in);
-  const ArcPlane* const in_slots = slots.empty() ? nullptr : slots.data();
+  const ArcPlane* const in_slots = slots.data();
   std::vector<Location> loc(from.num_faces());
   parallel_chunks(from.num_faces(), 256, [&](int begin, int end) {
     int hint = 0;

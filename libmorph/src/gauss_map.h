@@ -107,11 +107,29 @@ inline ArcPlane arc_plane(const Polytope& P, int e) {
 /// The planes of all arcs of P's Gauss map, indexed by edge.
 std::vector<ArcPlane> arc_planes(const Polytope& P);
 
+/// The planes of a Gauss map's fan slots (slot_planes), left uninitialised until made.
+class SlotPlanes {
+ public:
+  SlotPlanes() = default;
+  explicit SlotPlanes(std::size_t n)
+      : planes_(std::make_unique_for_overwrite<ArcPlane[]>(n)), size_(n) {}
+  std::size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  /// Null when empty.
+  const ArcPlane* data() const { return planes_.get(); }
+  ArcPlane* data() { return planes_.get(); }
+  const ArcPlane& operator[](std::size_t s) const { return planes_[s]; }
+
+ private:
+  std::unique_ptr<ArcPlane[]> planes_;
+  std::size_t size_ = 0;
+};
+
 /// The planes per fan slot (polytope.h), each oriented as the slot runs: slot s's plane is
 /// N_fan[s] x N_fan[s + 1], its edge's plane or that negated (the same doubles: the
 /// products commute and a - b = -(b - a) exactly). A region's test then reads one
 /// contiguous block, with no edge lookups.
-std::vector<ArcPlane> slot_planes(const Polytope& P);
+SlotPlanes slot_planes(const Polytope& P);
 
 /// Sign of det(N_left, N_right, x) for edge e of P, whose arc's plane is `plane`.
 /// Its double stage alone: the sign, or kUndecided (polytope.h).
