@@ -1037,6 +1037,38 @@ TEST_CASE("halfspace_intersection: the precise stage is the same with and withou
   CHECK(compared > 100);
 }
 
+// The precise stage's determinant of three normals (the repair's and the guess's
+// orientation tests, after intervals): nearly coplanar normals, n_2 = n_0 + n_1 moved by
+// 2^-k, decided as the exact sign down to 2^-80 relative, of either sign, and exactly
+// coplanar ones never; scaled normals alike.
+TEST_CASE("halfspace_intersection: the precise determinant sign is exact") {
+  const V3<ExactN> n0 = to_exact_n({1, 0.25, -0.5}), n1 = to_exact_n({-0.3, 1, 0.1}),
+                   e = to_exact_n({0.2, -0.7, 1});
+  int decided = 0;
+  for (int scale : {0, -200, 200}) {
+    const ExactN f(std::ldexp(1.0, scale));
+    for (int k : {20, 50, 60, 80, 0}) {  // 0: exactly coplanar
+      for (double sign : {1.0, -1.0}) {
+        const ExactN t(k == 0 ? 0.0 : sign * std::ldexp(1.0, -k));
+        const V3<ExactN> n2{n0.x + n1.x + t * e.x, n0.y + n1.y + t * e.y, n0.z + n1.z + t * e.z};
+        std::vector<HalfSpace> hs;
+        for (const V3<ExactN>& n : {n0, n1, n2})
+          hs.push_back({{n.x * f, n.y * f, n.z * f}, ExactN(1), ExactN(1), 0, -1});
+        const int want = CGAL::sign(det(n0, n1, n2));
+        const PreciseProbe probe = probe_precise(hs);
+        if (k == 0) {
+          CHECK(want == 0);
+          CHECK(probe.det == 2);
+          continue;
+        }
+        CHECK(probe.det == want);
+        decided += probe.det == want;
+      }
+    }
+  }
+  CHECK(decided == 24);
+}
+
 // The precise stage of side and compare_along: exact zeros (a fourth plane through the
 // vertex, two vertices on one plane parallel to the fourth) stay undecided, and every
 // sign it decides is the exact sign, down to moves of 2^-90 relative.

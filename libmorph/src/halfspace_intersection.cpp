@@ -1083,6 +1083,33 @@ int det_sign(const Plane& a, const Plane& b, const Plane& c) {
   return s != 2 ? s : CGAL::sign(det(*a.n, *b.n, *c.n));
 }
 
+/// Sign of det(n_a, n_b, n_c) from the precise stage, or 2 (round-to-nearest; valid planes):
+/// the W of their precise meet, within ew of the determinant of the precise normals (each
+/// n times a positive power of two: the same sign); hi decides beyond 1.01 ew (|lo| is
+/// below 2^-53 |hi|).
+int precise_det_sign(const PrecisePlane& a, const PrecisePlane& b, const PrecisePlane& c) {
+  HVertex v;
+  const V3<DD> na = normal_dd(a), nb = normal_dd(b), nc = normal_dd(c);
+  precise_meet(a, b, c, cross_dd(nb, nc), cross_dd(nc, na), cross_dd(na, nb), v);
+  const double bound = 1.01 * v.ew;
+  return v.pw.hi > bound ? 1 : v.pw.hi < -bound ? -1 : 2;
+}
+
+/// det_sign of planes a, b, c with the precise stage between intervals and Mpzf (nearly
+/// parallel normals: a fine mesh's facets around a vertex, which the repair's flips test).
+int det_sign(const std::vector<Plane>& planes, const PrecisePlanes& precise, int a, int b, int c) {
+  const Plane &pa = planes[a], &pb = planes[b], &pc = planes[c];
+  const int s = interval_sign(det(pa.ni, pb.ni, pc.ni));
+  if (s != 2) return s;
+  {
+    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    const PrecisePlane &x = precise[a], &y = precise[b], &z = precise[c];
+    const int t = x.valid && y.valid && z.valid ? precise_det_sign(x, y, z) : 2;
+    if (t != 2) return t;
+  }
+  return CGAL::sign(det(*pa.n, *pb.n, *pc.n));
+}
+
 }  // namespace
 
 // A double within an ulp or two of X / W, moved until X / W lies between the midpoints to
@@ -1393,9 +1420,7 @@ bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& preci
     }
     return s.vertex[t];
   };
-  const auto positive = [&](int a, int b, int c) {
-    return det_sign(planes[a], planes[b], planes[c]) > 0;
-  };
+  const auto positive = [&](int a, int b, int c) { return det_sign(planes, precise, a, b, c) > 0; };
   // Sets the across of triangle t's edge x -> y to `to`; false when t has no such edge.
   const auto relink = [&](int t, int x, int y, int to) {
     const int k = slot_of(t, x);
@@ -1565,7 +1590,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       const HVertex& v = s.vertex[t];
       if (v.known < 0 && v.planes == s.corner[t] && w_positive(v)) return true;
     }
-    return det_sign(planes[s.corner[t][0]], planes[s.corner[t][1]], planes[s.corner[t][2]]) > 0;
+    return det_sign(planes, precise, s.corner[t][0], s.corner[t][1], s.corner[t][2]) > 0;
   };
   std::atomic<bool> ok = true;
   parallel_chunks(s.oriented ? 0 : nt, 512, [&](int begin, int end) {
@@ -2511,6 +2536,8 @@ PreciseProbe probe_precise(const std::vector<HalfSpace>& hs) {
   u.planes = {0, 1, 2};
   make_precise(precise, u);
   probe_rounding(u, out);
+  if (precise[0].valid && precise[1].valid && precise[2].valid)
+    out.det = precise_det_sign(precise[0], precise[1], precise[2]);
   if (hs.size() < 4 || !u.precise || !precise[3].valid) return out;
   out.side = precise_side(precise[3], u);
   if (hs.size() < 7) return out;
@@ -2755,7 +2782,7 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
     if (ready[t]) return true;
     compute_vertex(t);
     const std::array<int, 3>& abc = vertex[t].planes;
-    return w_positive(vertex[t]) || det_sign(planes[abc[0]], planes[abc[1]], planes[abc[2]]) > 0;
+    return w_positive(vertex[t]) || det_sign(planes, precise, abc[0], abc[1], abc[2]) > 0;
   };
   // The triangle holding the directed edge a -> c and that edge's slot in it, or -1.
   const auto find = [&](int a, int c, int& slot) {

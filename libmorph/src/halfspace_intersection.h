@@ -161,9 +161,10 @@ struct PreciseProbe {
   std::array<bool, 3> decided{false, false, false};
   int side = 2;     // of <n, u> - d for hs[3]
   int compare = 2;  // of <n, u> - <n, v> for hs[3]'s normal n
+  int det = 2;      // of det(n_0, n_1, n_2)
 };
-/// u is the meet of the planes of hs[0], hs[1] and hs[2] (det of their normals > 0); v, when
-/// hs has 7 half-spaces, that of hs[4], hs[5] and hs[6].
+/// u is the meet of the planes of hs[0], hs[1] and hs[2] (det of their normals > 0 for all
+/// but `det`); v, when hs has 7 half-spaces, that of hs[4], hs[5] and hs[6].
 PreciseProbe probe_precise(const std::vector<HalfSpace>& hs);
 /// The rounding of a point known exactly, X / W (W > 0), as an erosion's known points.
 PreciseProbe probe_precise_point(const V3<ExactN>& X, const ExactN& W);
