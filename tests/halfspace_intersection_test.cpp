@@ -592,8 +592,9 @@ TEST_CASE("halfspace_intersection: an erosion's quadrilateral half-spaces are ex
 // facets) every third seed, else a random polytope of 11 to 22 vertices.
 namespace {
 morph::Mesh random_element(std::uint64_t seed) {
-  return seed % 3 == 0 ? morph::test::random_integer_polytope(8, seed, 2)
-                       : morph::test::random_sphere_polytope(10 + static_cast<int>(seed), seed + 50);
+  return seed % 3 == 0
+             ? morph::test::random_integer_polytope(8, seed, 2)
+             : morph::test::random_sphere_polytope(10 + static_cast<int>(seed), seed + 50);
 }
 }  // namespace
 
@@ -908,7 +909,8 @@ TEST_CASE("halfspace_intersection: the precise stage rounds next to powers of tw
             for (double w : {1.0, 3.0, 0x1p-300}) {
               const ExactN W(w), X = v * W;
               const PreciseProbe probe = probe_precise_point({X, X, X}, W);
-              if (k == 1) CHECK(!probe.decided[0]);
+              // (W = 1: X is exact in double-double, rounded by one addition; see below.)
+              if (k == 1 && w != 1.0) CHECK(!probe.decided[0]);
               if (!probe.decided[0]) continue;
               ++decided;
               CHECK(same_double(probe.rounded.x, rounded_exactly(v)));
@@ -921,14 +923,60 @@ TEST_CASE("halfspace_intersection: the precise stage rounds next to powers of tw
   CHECK(decided > 100);
 }
 
+// A known point X / 1 whose X is exact in double-double (an erosion's v - b of doubles, often
+// one bit beyond a double: a rounding tie) rounds by hi + lo, ties to even: decided at ties,
+// where the precise rounding never decides (above), and as the exact rounding; X beyond
+// double-double takes the precise rounding.
+TEST_CASE("halfspace_intersection: known points exact in double-double round ties to even") {
+  int ties = 0;
+  for (int e : {0, -2, 30, -300}) {
+    for (double sign : {1.0, -1.0}) {
+      for (int odd : {0, 1}) {  // x's last bit: the tie goes to x, or away from it
+        const double m = std::ldexp(1.0, e), x = sign * (odd ? std::nextafter(m, HUGE_VAL) : m);
+        const double gap = std::nextafter(std::abs(x), HUGE_VAL) - std::abs(x);
+        const ExactN mid = ExactN(x) + ExactN(sign * gap / 2);
+        const ExactN near = mid + ExactN(sign * std::ldexp(gap, -40));    // in double-double
+        const ExactN beyond = mid - ExactN(sign * std::ldexp(gap, -90));  // beyond it
+        INFO(e, " ", sign, " ", odd);
+        const PreciseProbe tie = probe_precise_point({mid, near, -mid}, ExactN(1));
+        CHECK(tie.decided == std::array<bool, 3>{true, true, true});
+        CHECK(same_double(tie.rounded.x, rounded_exactly(mid)));
+        CHECK(same_double(tie.rounded.x, odd ? x + sign * gap : x));
+        CHECK(same_double(tie.rounded.y, rounded_exactly(near)));
+        CHECK(same_double(tie.rounded.z, -tie.rounded.x));
+        // A coordinate beyond double-double: the precise rounding, never at the tie.
+        const PreciseProbe other = probe_precise_point({mid, near, beyond}, ExactN(1));
+        CHECK(!other.decided[0]);
+        if (other.decided[1]) CHECK(same_double(other.rounded.y, rounded_exactly(near)));
+        if (other.decided[2]) CHECK(same_double(other.rounded.z, rounded_exactly(beyond)));
+        ++ties;
+      }
+    }
+  }
+  CHECK(ties == 16);
+  // Differences of doubles a - b, a's ulp twice b's: ties for odd b.
+  for (double a : {0.7, -0.44, 3.25}) {
+    for (double b : {0.25 / 3, -0.1 / 7, 0x1.0000000000001p-3}) {
+      const V3<ExactN> X = exact_difference(V3<double>{a, b, a}, V3<double>{b, a, -b});
+      const PreciseProbe probe = probe_precise_point(X, ExactN(1));
+      const ExactN* c[3] = {&X.x, &X.y, &X.z};
+      const double got[3] = {probe.rounded.x, probe.rounded.y, probe.rounded.z};
+      for (int i = 0; i < 3; ++i) {
+        CHECK(probe.decided[i]);
+        CHECK(same_double(got[i], rounded_exactly(*c[i])));
+      }
+    }
+  }
+}
+
 namespace {
 
 // Seven planes around an adversarial point p: three through p (scaled by 2^scale), a fourth
 // through p moved by 2^-bits of the magnitude of <n, p> (sign: its direction), and three
 // through q (scaled by 2^q_scale), p moved along the fourth plane's normal by 2^-bits of p's
 // size (the sign of <n, p - q> is -sign).
-std::vector<HalfSpace> moved_fourth(const V3<ExactN>& p, int scale, int q_scale, int bits,
-                                    int sign, V3<ExactN>& q) {
+std::vector<HalfSpace> moved_fourth(const V3<ExactN>& p, int scale, int q_scale, int bits, int sign,
+                                    V3<ExactN>& q) {
   std::vector<HalfSpace> hs =
       three_through({1, 0.25, -0.5}, {-0.3, 1, 0.1}, {0.2, -0.7, 1}, p, scale);
   HalfSpace h = plane_through({0.3, 0.3, 0.9 + 0x1p-30}, p, scale);
@@ -948,6 +996,78 @@ std::vector<HalfSpace> moved_fourth(const V3<ExactN>& p, int scale, int q_scale,
 }
 
 }  // namespace
+
+// The precise stage's fused multiply-add arithmetic (where the processor has it) gives what
+// Dekker's splits give: the same roundings decided, to the same doubles, and the same signs,
+// on adversarial points, tilted and scaled planes.
+TEST_CASE("halfspace_intersection: the precise stage is the same with and without FMA") {
+  if (!set_precise_fma(true)) {
+    MESSAGE("no FMA on this processor: one route only");
+    return;
+  }
+  int compared = 0;
+  for (const auto& [p, k] : adversarial_points()) {
+    for (int scale : {0, -200, 200}) {
+      for (double tilt : {0.0, 0x1p-20, 0x1p-45}) {
+        const V3<double> n0{1, 0.25, -0.5}, n1{-0.3, 1, 0.1};
+        const V3<double> n2 =
+            tilt == 0 ? V3<double>{0.2, -0.7, 1} : V3<double>{n0.x + tilt, n0.y - tilt, n0.z};
+        for (int bits : {30, 90}) {
+          V3<ExactN> q;
+          std::vector<HalfSpace> hs = moved_fourth(p, scale, -scale, bits, 1, q);
+          const std::vector<HalfSpace> tilted = three_through(n0, n1, n2, p, scale);
+          for (int i = 0; i < 3; ++i) hs[i] = tilted[i];
+          set_precise_fma(true);
+          const PreciseProbe fused = probe_precise(hs);
+          set_precise_fma(false);
+          const PreciseProbe split = probe_precise(hs);
+          set_precise_fma(true);
+          CHECK(fused.decided == split.decided);
+          CHECK(fused.side == split.side);
+          CHECK(fused.compare == split.compare);
+          const double f[3] = {fused.rounded.x, fused.rounded.y, fused.rounded.z},
+                       d[3] = {split.rounded.x, split.rounded.y, split.rounded.z};
+          for (int i = 0; i < 3; ++i)
+            if (fused.decided[i] && split.decided[i]) CHECK(same_double(f[i], d[i]));
+          compared += fused.decided[0] + fused.decided[1] + fused.decided[2];
+        }
+      }
+    }
+  }
+  CHECK(compared > 100);
+}
+
+// The precise stage's determinant of three normals (the repair's and the guess's
+// orientation tests, after intervals): nearly coplanar normals, n_2 = n_0 + n_1 moved by
+// 2^-k, decided as the exact sign down to 2^-80 relative, of either sign, and exactly
+// coplanar ones never; scaled normals alike.
+TEST_CASE("halfspace_intersection: the precise determinant sign is exact") {
+  const V3<ExactN> n0 = to_exact_n({1, 0.25, -0.5}), n1 = to_exact_n({-0.3, 1, 0.1}),
+                   e = to_exact_n({0.2, -0.7, 1});
+  int decided = 0;
+  for (int scale : {0, -200, 200}) {
+    const ExactN f(std::ldexp(1.0, scale));
+    for (int k : {20, 50, 60, 80, 0}) {  // 0: exactly coplanar
+      for (double sign : {1.0, -1.0}) {
+        const ExactN t(k == 0 ? 0.0 : sign * std::ldexp(1.0, -k));
+        const V3<ExactN> n2{n0.x + n1.x + t * e.x, n0.y + n1.y + t * e.y, n0.z + n1.z + t * e.z};
+        std::vector<HalfSpace> hs;
+        for (const V3<ExactN>& n : {n0, n1, n2})
+          hs.push_back({{n.x * f, n.y * f, n.z * f}, ExactN(1), ExactN(1), 0, -1});
+        const int want = CGAL::sign(det(n0, n1, n2));
+        const PreciseProbe probe = probe_precise(hs);
+        if (k == 0) {
+          CHECK(want == 0);
+          CHECK(probe.det == 2);
+          continue;
+        }
+        CHECK(probe.det == want);
+        decided += probe.det == want;
+      }
+    }
+  }
+  CHECK(decided == 24);
+}
 
 // The precise stage of side and compare_along: exact zeros (a fourth plane through the
 // vertex, two vertices on one plane parallel to the fourth) stay undecided, and every

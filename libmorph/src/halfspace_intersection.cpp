@@ -38,7 +38,6 @@
 #include <deque>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <numeric>
 #include <thread>
 
@@ -264,6 +263,9 @@ struct HVertex {
   double ew = 0;
   bool precise = false;
   bool precise_tried = false;  // make_precise was called (it may have left it out)
+  // A known point with W = 1 whose X is exactly px (hi + lo), pw = 1: its rounding is
+  // hi + lo in one rounded addition (make_precise).
+  bool exact_dd = false;
   bool doubles = false;  // a known point X / 1 with X exactly doubles: its rounding is X
   // Xi, Wi and xi are set (`intervals`), or only the double filter's X and W with their
   // magnitudes (`fast`, made from fast planes: kMeetError), the intervals then made where
@@ -541,6 +543,29 @@ bool precise_scaled(const std::array<const ExactN*, 4>& c, int lead_begin, int l
   return true;
 }
 
+/// x exactly as a double-double hi + lo (round-to-nearest), or false when it is not one (or
+/// out of range). to_dd's enclosure of x - hi may be loose where x spans two Mpzf limbs:
+/// then an exact comparison tells whether x - hi is one of its ends.
+bool split_exactly(const ExactN& x, DD& out) {
+  if (CGAL::sign(x) == CGAL::ZERO) {
+    out = {0, 0};
+    return true;
+  }
+  const double hi = x.to_double();  // within an ulp of x
+  if (!std::isfinite(hi)) return false;
+  const ExactN rest = x - ExactN(hi);
+  const std::pair<double, double> r = rest.to_interval();
+  double lo = r.first;
+  if (r.first != r.second) {
+    if (rest == ExactN(r.second))
+      lo = r.second;
+    else if (!(rest == ExactN(r.first)))
+      return false;
+  }
+  out = quick_two_sum(hi, lo);  // exact: |lo| is at most an ulp of hi
+  return true;
+}
+
 /// A plane's n.x, n.y, n.z, d times a power of two (any positive factor leaves every sign
 /// and every meet unchanged) in double-double: precise_scaled with the largest normal
 /// component in [1, 2), so |d| <= 2^400 and every non-zero component is above 2^-900 (the
@@ -560,18 +585,97 @@ PrecisePlane precise_plane(const Plane& plane) {
 V3<DD> normal_dd(const PrecisePlane& p) { return {p.c[0], p.c[1], p.c[2]}; }
 V3<Magnitude> normal_magnitude(const PrecisePlane& p) { return magnitude(normal_dd(p)); }
 
+/// Double-double arithmetic as exact.h's, but for a product's error term: one fused
+/// multiply-add instead of Dekker's splits, on processors with FMA (has_fma). Both are
+/// a b - hi exactly (while no partial product underflows; below that both err by less than
+/// the absolute terms of the bounds), so the results, and the decisions, are the same.
+struct FmaDD {
+  double hi, lo;
+};
+[[gnu::target("fma"), gnu::optimize("fp-contract=off")]] inline FmaDD operator+(const FmaDD& a,
+                                                                                const FmaDD& b) {
+  const DD s = two_sum(a.hi, b.hi);
+  const DD r = quick_two_sum(s.hi, s.lo + (a.lo + b.lo));
+  return {r.hi, r.lo};
+}
+[[gnu::target("fma"), gnu::optimize("fp-contract=off")]] inline FmaDD operator-(const FmaDD& a) {
+  return {-a.hi, -a.lo};
+}
+[[gnu::target("fma"), gnu::optimize("fp-contract=off")]] inline FmaDD operator-(const FmaDD& a,
+                                                                                const FmaDD& b) {
+  return a + -b;
+}
+[[gnu::target("fma"), gnu::optimize("fp-contract=off")]] inline FmaDD operator*(const FmaDD& a,
+                                                                                const FmaDD& b) {
+  const double p = a.hi * b.hi;
+  const DD r = quick_two_sum(p, __builtin_fma(a.hi, b.hi, -p) + (a.hi * b.lo + a.lo * b.hi));
+  return {r.hi, r.lo};
+}
+const bool cpu_has_fma = __builtin_cpu_supports("fma");
+bool has_fma = cpu_has_fma;  // (set_precise_fma: tests compare both)
+/// two_prod by a fused multiply-add: a b = hi + lo exactly (as Dekker's, in fewer operations).
+[[gnu::target("fma"), gnu::optimize("fp-contract=off")]] inline DD fma_two_prod(double a,
+                                                                                double b) {
+  const double p = a * b;
+  return {p, __builtin_fma(a, b, -p)};
+}
+
+template <class D>
+V3<D> as(const V3<DD>& v) {
+  return {{v.x.hi, v.x.lo}, {v.y.hi, v.y.lo}, {v.z.hi, v.z.lo}};
+}
+template <class D>
+V3<DD> from(const V3<D>& v) {
+  return {{v.x.hi, v.x.lo}, {v.y.hi, v.y.lo}, {v.z.hi, v.z.lo}};
+}
+
 /// n x m in double-double, its operations inlined (these run for most vertices; the
-/// arithmetic is exact.h's, so are the results and bounds).
-[[gnu::flatten]] V3<DD> cross_dd(const V3<DD>& n, const V3<DD>& m) { return cross(n, m); }
+/// arithmetic is exact.h's, or FmaDD's, so are the results and bounds).
+template <class D>
+V3<DD> cross_in(const V3<DD>& n, const V3<DD>& m) {
+  return from(cross(as<D>(n), as<D>(m)));
+}
+[[gnu::flatten]] V3<DD> cross_plain(const V3<DD>& n, const V3<DD>& m) { return cross_in<DD>(n, m); }
+[[gnu::flatten, gnu::target("fma"), gnu::optimize("fp-contract=off")]] V3<DD> cross_fma(
+    const V3<DD>& n, const V3<DD>& m) {
+  return cross_in<FmaDD>(n, m);
+}
+V3<DD> cross_dd(const V3<DD>& n, const V3<DD>& m) {
+  return has_fma ? cross_fma(n, m) : cross_plain(n, m);
+}
 
 /// The precise meet of valid planes a, b, c (round-to-nearest) from their normals' cross
 /// products bc, ca, ab in double-double, each as `cross` evaluates it or that negated (the
 /// same value of the opposite edge, n_b x n_a = -(n_a x n_b): negation is exact, so the
 /// bound below holds alike).
+template <class D>
+void meet_in(const PrecisePlane& a, const PrecisePlane& b, const PrecisePlane& c, const V3<DD>& bc,
+             const V3<DD>& ca, const V3<DD>& ab, HVertex& v) {
+  const auto one = [](const DD& x) { return D{x.hi, x.lo}; };
+  V3<D> X;
+  D W;
+  meet_of_crosses(as<D>(normal_dd(a)), one(a.c[3]), one(b.c[3]), one(c.c[3]), as<D>(bc), as<D>(ca),
+                  as<D>(ab), X, W);
+  v.px = from(X);
+  v.pw = {W.hi, W.lo};
+}
+[[gnu::flatten]] void meet_plain(const PrecisePlane& a, const PrecisePlane& b,
+                                 const PrecisePlane& c, const V3<DD>& bc, const V3<DD>& ca,
+                                 const V3<DD>& ab, HVertex& v) {
+  meet_in<DD>(a, b, c, bc, ca, ab, v);
+}
+[[gnu::flatten, gnu::target("fma"), gnu::optimize("fp-contract=off")]] void meet_fma(
+    const PrecisePlane& a, const PrecisePlane& b, const PrecisePlane& c, const V3<DD>& bc,
+    const V3<DD>& ca, const V3<DD>& ab, HVertex& v) {
+  meet_in<FmaDD>(a, b, c, bc, ca, ab, v);
+}
 [[gnu::flatten]] void precise_meet(const PrecisePlane& a, const PrecisePlane& b,
                                    const PrecisePlane& c, const V3<DD>& bc, const V3<DD>& ca,
                                    const V3<DD>& ab, HVertex& v) {
-  meet_of_crosses(normal_dd(a), a.c[3], b.c[3], c.c[3], bc, ca, ab, v.px, v.pw);
+  if (has_fma)
+    meet_fma(a, b, c, bc, ca, ab, v);
+  else
+    meet_plain(a, b, c, bc, ca, ab, v);
   V3<Magnitude> mx;
   Magnitude mw;
   meet(normal_magnitude(a), magnitude(a.c[3]), normal_magnitude(b), magnitude(b.c[3]),
@@ -641,6 +745,30 @@ void make_precise(const PrecisePlanes& planes, HVertex& v,
                   const std::array<V3<DD>, 3>* crosses = nullptr) {
   v.precise_tried = true;
   if (v.known >= 0) {
+    // W = 1 (an erosion's v - b of double points, a closing's exact sums): X is usually
+    // exactly hi + lo, often one bit beyond a double (a rounding tie, which the precise
+    // rounding cannot settle). It is then doubles when every lo is zero, and otherwise
+    // rounds by hi + lo (exact_dd); its precise copy is that of precise_scaled below (the
+    // scale 1), but exact.
+    DD d[3];
+    if (v.W->is_one() && split_exactly(v.X->x, d[0]) && split_exactly(v.X->y, d[1]) &&
+        split_exactly(v.X->z, d[2])) {
+      v.doubles = d[0].lo == 0 && d[1].lo == 0 && d[2].lo == 0;
+      if (v.doubles) return;
+      bool in_range = true;  // (as precise_scaled's)
+      for (const DD& x : d)
+        in_range =
+            in_range && (x.hi == 0 || (std::abs(x.hi) >= 0x1p-900 && std::abs(x.hi) <= 0x1p400));
+      if (in_range) {
+        v.px = {d[0], d[1], d[2]};
+        v.pw = {1, 0};
+        v.ex = {kPlaneRelative * std::abs(d[0].hi), kPlaneRelative * std::abs(d[1].hi),
+                kPlaneRelative * std::abs(d[2].hi)};
+        v.ew = kPlaneRelative;
+        v.precise = v.exact_dd = true;
+        return;
+      }
+    }
     const auto is_double = [](const ExactN& x) {
       const double d = x.to_double();
       return std::isfinite(d) && x == ExactN(d);
@@ -766,9 +894,9 @@ int side_exact(const Plane& p, const HVertex& v) {
 
 /// Sign of <n, x> - d for plane i at a vertex: the double filter, then the precise stage
 /// (the vertex made precise when first needed there; a known point skips it, as in
-/// side_filter), then intervals, then exact coordinates (computed once). Planes nearly through one point
-/// (the moved facets around a vertex of a nearly planar A) leave most of these tests to
-/// the precise stage.
+/// side_filter), then intervals, then exact coordinates (computed once). Planes nearly through one
+/// point (the moved facets around a vertex of a nearly planar A) leave most of these tests to the
+/// precise stage.
 int side(const std::vector<Plane>& planes, const PrecisePlanes& precise, int i, HVertex& v) {
   const Plane& p = planes[i];
   int s = double_side(p, v);
@@ -812,8 +940,7 @@ int compare_filter(const std::vector<Plane>& planes, const PrecisePlanes& precis
     Interval Wi;
     if (!u.intervals) interval_meet(planes, u.planes, Xi, Wi, ui);
     if (!v.intervals) interval_meet(planes, v.planes, Xi, Wi, vi);
-    return interval_sign(dot(p.ni, u.intervals ? u.xi : ui) -
-                         dot(p.ni, v.intervals ? v.xi : vi));
+    return interval_sign(dot(p.ni, u.intervals ? u.xi : ui) - dot(p.ni, v.intervals ? v.xi : vi));
   };
   if (stage && precise.made(i)) {
     const int t = precise_sign();
@@ -826,23 +953,57 @@ int compare_exact(const Plane& p, const HVertex& u, const HVertex& v) {
   return CGAL::sign(dot(*p.n, *u.X) * *v.W - dot(*p.n, *v.X) * *u.W);
 }
 
+/// One-time initialisations by index: call(i, f) runs f once for each i, in whichever thread
+/// asks first, the others waiting for it (as PrecisePlanes' flags). std::call_once makes a
+/// futex system call each time it runs f (glibc wakes waiters unconditionally), which cost
+/// more than the rounding it guarded.
+class OnceFlags {
+ public:
+  explicit OnceFlags(std::size_t n) : state_(std::make_unique<std::atomic<unsigned char>[]>(n)) {}
+  template <class F>
+  void call(std::size_t i, const F& f) const {
+    if (state_[i].load(std::memory_order_acquire) != kDone) run(i, f);
+  }
+
+ private:
+  static constexpr unsigned char kNone = 0, kRunning = 1, kDone = 2;
+  // As PrecisePlanes::make: a run that throws gives its claim back.
+  template <class F>
+  [[gnu::noinline]] void run(std::size_t i, const F& f) const {
+    for (;;) {
+      unsigned char expected = kNone;
+      if (state_[i].compare_exchange_strong(expected, kRunning, std::memory_order_acquire)) {
+        try {
+          f();
+        } catch (...) {
+          state_[i].store(kNone, std::memory_order_release);
+          throw;
+        }
+        state_[i].store(kDone, std::memory_order_release);
+        return;
+      }
+      if (expected == kDone) return;
+      std::this_thread::yield();
+    }
+  }
+  std::unique_ptr<std::atomic<unsigned char>[]> state_;  // value-initialised: kNone
+};
+
 /// Exact vertex coordinates made on first use, by whichever thread needs them first (each
 /// at most once; they do not depend on the thread, so neither does any decision).
 class LazyExact {
  public:
   LazyExact(const std::vector<Plane>& planes, std::vector<HVertex>& vertex)
-      : planes_(planes),
-        vertex_(vertex),
-        once_(std::make_unique<std::once_flag[]>(vertex.size())) {}
+      : planes_(planes), vertex_(vertex), once_(vertex.size()) {}
   const HVertex& operator()(int v) {
-    std::call_once(once_[v], [&] { make_exact(planes_, vertex_[v]); });
+    once_.call(v, [&] { make_exact(planes_, vertex_[v]); });
     return vertex_[v];
   }
 
  private:
   const std::vector<Plane>& planes_;
   std::vector<HVertex>& vertex_;
-  std::unique_ptr<std::once_flag[]> once_;
+  OnceFlags once_;
 };
 
 /// The double next to r (non-zero, finite, below the largest) away from zero when `away`,
@@ -862,15 +1023,17 @@ double step_away(double r, bool away) {
 /// (any double serves: it only proposes candidates, which are checked), computed once for a
 /// vertex's three coordinates: multiplications instead of two divisions each, whose latency
 /// showed in the rounding loop's profile.
-[[gnu::flatten]] bool round_precise(const DD& X, double ex, const DD& W, double ew, double inverse,
-                                    double& out) {
+template <bool kFma>
+inline bool round_precise_in(const DD& X, double ex, const DD& W, double ew, double inverse,
+                             double& out) {
   if (!(W.hi >= 0x1p-300 && W.hi <= 0x1p300) || !(ew <= 0x1p-60 * W.hi)) return false;
-  // The residual R = X - r W in double-double: the product r W.hi is exact (Dekker), and
-  // so is the cancelling X.hi - p.hi; what remains is small. `sum` bounds those small
-  // terms, whose three additions and the last one err by 2^-53 of them each.
+  // The residual R = X - r W in double-double: the product r W.hi is exact (Dekker, or one
+  // fused multiply-add: the same value), and so is the cancelling X.hi - p.hi; what remains
+  // is small. `sum` bounds those small terms, whose three additions and the last one err by
+  // 2^-53 of them each.
   double sum = 0;
   const auto residual = [&](double r) {
-    const DD p = two_prod(r, W.hi), s = two_sum(X.hi, -p.hi);
+    const DD p = kFma ? fma_two_prod(r, W.hi) : two_prod(r, W.hi), s = two_sum(X.hi, -p.hi);
     const double q = r * W.lo;
     sum = std::abs(s.lo) + std::abs(X.lo) + std::abs(p.lo) + std::abs(q);
     return s.hi + (((s.lo + X.lo) - p.lo) - q);
@@ -902,10 +1065,49 @@ double step_away(double r, bool away) {
   out = r;
   return true;
 }
+[[gnu::flatten]] bool round_precise_plain(const DD& X, double ex, const DD& W, double ew,
+                                          double inverse, double& out) {
+  return round_precise_in<false>(X, ex, W, ew, inverse, out);
+}
+[[gnu::flatten, gnu::target("fma"), gnu::optimize("fp-contract=off")]] bool round_precise_fma(
+    const DD& X, double ex, const DD& W, double ew, double inverse, double& out) {
+  return round_precise_in<true>(X, ex, W, ew, inverse, out);
+}
+bool round_precise(const DD& X, double ex, const DD& W, double ew, double inverse, double& out) {
+  return has_fma ? round_precise_fma(X, ex, W, ew, inverse, out)
+                 : round_precise_plain(X, ex, W, ew, inverse, out);
+}
 
 int det_sign(const Plane& a, const Plane& b, const Plane& c) {
   const int s = interval_sign(det(a.ni, b.ni, c.ni));
   return s != 2 ? s : CGAL::sign(det(*a.n, *b.n, *c.n));
+}
+
+/// Sign of det(n_a, n_b, n_c) from the precise stage, or 2 (round-to-nearest; valid planes):
+/// the W of their precise meet, within ew of the determinant of the precise normals (each
+/// n times a positive power of two: the same sign); hi decides beyond 1.01 ew (|lo| is
+/// below 2^-53 |hi|).
+int precise_det_sign(const PrecisePlane& a, const PrecisePlane& b, const PrecisePlane& c) {
+  HVertex v;
+  const V3<DD> na = normal_dd(a), nb = normal_dd(b), nc = normal_dd(c);
+  precise_meet(a, b, c, cross_dd(nb, nc), cross_dd(nc, na), cross_dd(na, nb), v);
+  const double bound = 1.01 * v.ew;
+  return v.pw.hi > bound ? 1 : v.pw.hi < -bound ? -1 : 2;
+}
+
+/// det_sign of planes a, b, c with the precise stage between intervals and Mpzf (nearly
+/// parallel normals: a fine mesh's facets around a vertex, which the repair's flips test).
+int det_sign(const std::vector<Plane>& planes, const PrecisePlanes& precise, int a, int b, int c) {
+  const Plane &pa = planes[a], &pb = planes[b], &pc = planes[c];
+  const int s = interval_sign(det(pa.ni, pb.ni, pc.ni));
+  if (s != 2) return s;
+  {
+    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    const PrecisePlane &x = precise[a], &y = precise[b], &z = precise[c];
+    const int t = x.valid && y.valid && z.valid ? precise_det_sign(x, y, z) : 2;
+    if (t != 2) return t;
+  }
+  return CGAL::sign(det(*pa.n, *pb.n, *pc.n));
 }
 
 }  // namespace
@@ -996,7 +1198,7 @@ class VertexExactPoints final : public LazyExactPoints {
       : planes_(owner ? planes : std::vector<Plane>(planes.size())),
         vertex_(std::move(vertex)),
         order_(std::move(order)),
-        once_(std::make_unique<std::once_flag[]>(order_.size())),
+        once_(order_.size()),
         owner_(std::move(owner)) {
     if (owner_) return;
     parallel_chunks(static_cast<int>(vertex_.size()), 256, [&](int begin, int end) {
@@ -1019,16 +1221,16 @@ class VertexExactPoints final : public LazyExactPoints {
   }
   void get(int r, const V3<ExactN>*& X, const ExactN*& W) const override {
     HVertex& v = vertex_[order_[r]];
-    std::call_once(once_[r], [&] { make_exact(planes_, v); });
+    once_.call(r, [&] { make_exact(planes_, v); });
     X = v.X;
     W = v.W;
   }
 
  private:
   std::vector<Plane> planes_;
-  mutable std::vector<HVertex> vertex_;  // each written once, under its once_flag
+  mutable std::vector<HVertex> vertex_;  // each written once, under its flag in once_
   std::vector<int> order_;
-  std::unique_ptr<std::once_flag[]> once_;
+  OnceFlags once_;
   std::shared_ptr<const void> owner_;  // of what planes_ and vertex_ point at, or null
 };
 
@@ -1218,9 +1420,7 @@ bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& preci
     }
     return s.vertex[t];
   };
-  const auto positive = [&](int a, int b, int c) {
-    return det_sign(planes[a], planes[b], planes[c]) > 0;
-  };
+  const auto positive = [&](int a, int b, int c) { return det_sign(planes, precise, a, b, c) > 0; };
   // Sets the across of triangle t's edge x -> y to `to`; false when t has no such edge.
   const auto relink = [&](int t, int x, int y, int to) {
     const int k = slot_of(t, x);
@@ -1390,7 +1590,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       const HVertex& v = s.vertex[t];
       if (v.known < 0 && v.planes == s.corner[t] && w_positive(v)) return true;
     }
-    return det_sign(planes[s.corner[t][0]], planes[s.corner[t][1]], planes[s.corner[t][2]]) > 0;
+    return det_sign(planes, precise, s.corner[t][0], s.corner[t][1], s.corner[t][2]) > 0;
   };
   std::atomic<bool> ok = true;
   parallel_chunks(s.oriented ? 0 : nt, 512, [&](int begin, int end) {
@@ -1667,8 +1867,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   {
     std::vector<char> used(n, 0);
     for (const HVertex& v : vertex)
-      if (v.known < 0 && !v.precise)
-        used[v.planes[0]] = used[v.planes[1]] = used[v.planes[2]] = 1;
+      if (v.known < 0 && !v.precise) used[v.planes[0]] = used[v.planes[1]] = used[v.planes[2]] = 1;
     parallel_chunks(n, 256, [&](int begin, int end) {
       for (int i = begin; i < end; ++i)
         if (used[i]) precise[i];
@@ -1799,9 +1998,9 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       for (std::size_t q = 0; q < plateau.size(); ++q)
         for (int a = adj_begin[plateau[q]]; a < adj_begin[plateau[q] + 1]; ++a)
           if (std::find(plateau.begin(), plateau.end(), adj[a]) == plateau.end() &&
-              (q == 0 && u_on ? sides[a - adj_begin[u]] == 0
-                              : known_through(known, others[j], vertex[adj[a]]) ||
-                                    side_of(i, adj[a]) == 0))
+              (q == 0 && u_on
+                   ? sides[a - adj_begin[u]] == 0
+                   : known_through(known, others[j], vertex[adj[a]]) || side_of(i, adj[a]) == 0))
             plateau.push_back(adj[a]);
       std::sort(plateau.begin(), plateau.end());
       touched[j].assign(plateau.begin(), plateau.end());
@@ -1912,14 +2111,18 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
           rounded[i] = coordinate(*v.X, i).to_double();
           continue;
         }
+        if (v.exact_dd) {  // X / 1 exactly hi + lo: the sum rounds it (ties to even)
+          rounded[i] = coordinate(v.px, i).hi + coordinate(v.px, i).lo;
+          continue;
+        }
         if (v.precise && round_precise(coordinate(v.px, i), coordinate(v.ex, i), v.pw, v.ew,
                                        inverse, rounded[i]))
           continue;
         const HVertex& e = exact_vertex(order[r]);
         // (Any estimate serves: round_quotient only starts from it.)
         const double q = v.intervals ? 0 : coordinate(v.Xd(), i) / v.Wd();
-        const Interval estimate = v.intervals ? coordinate(v.xi, i)
-                                              : Interval(std::isfinite(q) ? q : 0.0);
+        const Interval estimate =
+            v.intervals ? coordinate(v.xi, i) : Interval(std::isfinite(q) ? q : 0.0);
         rounded[i] = round_quotient(coordinate(*e.X, i), *e.W, estimate);
       }
       rp.points[r] = {rounded[0], rounded[1], rounded[2]};
@@ -2047,10 +2250,10 @@ class IncrementalHull {
     std::array<int, 3> c, across;  // edge k runs from corner k to corner k + 1
     V3<Interval> Xi;               // the vertex of the three planes, X / W
     Interval Wi;
-    int exact = -1;    // its exact coordinates in exact_, once computed
-    int precise = -1;  // its precise coordinates in precise_vertex_, once tried (-2: none)
-    int known = -1;    // the known point it is, if any (KnownPoints)
-    int pending = -1;  // first of the planes that see it (linked by next_pending_)
+    int exact = -1;     // its exact coordinates in exact_, once computed
+    int precise = -1;   // its precise coordinates in precise_vertex_, once tried (-2: none)
+    int known = -1;     // the known point it is, if any (KnownPoints)
+    int pending = -1;   // first of the planes that see it (linked by next_pending_)
     int replaced = -1;  // once removed: a new triangle made on one of its horizon edges
     bool alive = true;
   };
@@ -2079,7 +2282,7 @@ class IncrementalHull {
     return static_cast<int>(tris_.size()) - 1;
   }
   int add(int a, int b, int c) {
-    const V3<Interval> &na = plane(a).ni, &nb = plane(b).ni, &nc = plane(c).ni;
+    const V3<Interval>&na = plane(a).ni, &nb = plane(b).ni, &nc = plane(c).ni;
     return add(a, b, c, cross(na, nb), cross(nb, nc), cross(nc, na));
   }
 
@@ -2306,6 +2509,11 @@ void probe_rounding(const HVertex& v, PreciseProbe& out) {
     out.decided = {true, true, true};
   }
   if (!v.precise) return;
+  if (v.exact_dd) {
+    out.rounded = {v.px.x.hi + v.px.x.lo, v.px.y.hi + v.px.y.lo, v.px.z.hi + v.px.z.lo};
+    out.decided = {true, true, true};
+    return;
+  }
   const double inverse = 1 / v.pw.hi;
   out.decided = {round_precise(v.px.x, v.ex.x, v.pw, v.ew, inverse, out.rounded.x),
                  round_precise(v.px.y, v.ex.y, v.pw, v.ew, inverse, out.rounded.y),
@@ -2313,6 +2521,11 @@ void probe_rounding(const HVertex& v, PreciseProbe& out) {
 }
 
 }  // namespace
+
+bool set_precise_fma(bool use) {
+  has_fma = use && cpu_has_fma;
+  return cpu_has_fma;
+}
 
 PreciseProbe probe_precise(const std::vector<HalfSpace>& hs) {
   const std::vector<Plane> planes = planes_of(hs);
@@ -2323,6 +2536,8 @@ PreciseProbe probe_precise(const std::vector<HalfSpace>& hs) {
   u.planes = {0, 1, 2};
   make_precise(precise, u);
   probe_rounding(u, out);
+  if (precise[0].valid && precise[1].valid && precise[2].valid)
+    out.det = precise_det_sign(precise[0], precise[1], precise[2]);
   if (hs.size() < 4 || !u.precise || !precise[3].valid) return out;
   out.side = precise_side(precise[3], u);
   if (hs.size() < 7) return out;
@@ -2359,8 +2574,7 @@ PreciseProbe probe_precise_point(const V3<ExactN>& X, const ExactN& W) {
   return out;
 }
 
-void set_normal_dd(HalfSpace& h, const V3<double>& p0, const V3<double>& p1,
-                   const V3<double>& p2) {
+void set_normal_dd(HalfSpace& h, const V3<double>& p0, const V3<double>& p1, const V3<double>& p2) {
   CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
   // The edge vectors, each difference exact (two_sum's error term zero, no overflow).
   V3<double> e1, e2;
@@ -2546,7 +2760,7 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
     v.X = nullptr;
     v.W = nullptr;
     v.known = -1;
-    v.precise = v.precise_tried = false;
+    v.precise = v.precise_tried = v.exact_dd = false;
     v.planes = {p[i], p[j], p[l]};
     const Plane &a = planes[p[i]], &b = planes[p[j]], &c = planes[p[l]];
     if (fast) {
@@ -2555,8 +2769,8 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
       const auto& m = scratch.mcross;
       double_meet(a, b, c, d[bc], d[ca], d[ab], m[bc], m[ca], m[ab], v);
     } else {
-      meet_of_crosses(a.ni, a.di, b.di, c.di, cross_of(j, l), cross_of(l, i), cross_of(i, j),
-                      v.Xi, v.Wi);
+      meet_of_crosses(a.ni, a.di, b.di, c.di, cross_of(j, l), cross_of(l, i), cross_of(i, j), v.Xi,
+                      v.Wi);
       v.intervals = true;
       v.fast = false;
     }
@@ -2568,7 +2782,7 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
     if (ready[t]) return true;
     compute_vertex(t);
     const std::array<int, 3>& abc = vertex[t].planes;
-    return w_positive(vertex[t]) || det_sign(planes[abc[0]], planes[abc[1]], planes[abc[2]]) > 0;
+    return w_positive(vertex[t]) || det_sign(planes, precise, abc[0], abc[1], abc[2]) > 0;
   };
   // The triangle holding the directed edge a -> c and that edge's slot in it, or -1.
   const auto find = [&](int a, int c, int& slot) {

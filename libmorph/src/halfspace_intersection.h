@@ -42,8 +42,7 @@ struct HalfSpace {
 /// Sets h.normal_dd from h.normal = (p1 - p0) x (p2 - p0) for a triangle of double points
 /// (its Newell normal), when the differences are exact in doubles and the products and the
 /// bound allow; leaves h unchanged otherwise.
-void set_normal_dd(HalfSpace& h, const V3<double>& p0, const V3<double>& p1,
-                   const V3<double>& p2);
+void set_normal_dd(HalfSpace& h, const V3<double>& p0, const V3<double>& p1, const V3<double>& p2);
 
 /// The half-space <normal, x> <= offset for any rational offset.
 HalfSpace make_halfspace(const V3<ExactN>& normal, const Exact& offset, int source);
@@ -162,12 +161,17 @@ struct PreciseProbe {
   std::array<bool, 3> decided{false, false, false};
   int side = 2;     // of <n, u> - d for hs[3]
   int compare = 2;  // of <n, u> - <n, v> for hs[3]'s normal n
+  int det = 2;      // of det(n_0, n_1, n_2)
 };
-/// u is the meet of the planes of hs[0], hs[1] and hs[2] (det of their normals > 0); v, when
-/// hs has 7 half-spaces, that of hs[4], hs[5] and hs[6].
+/// u is the meet of the planes of hs[0], hs[1] and hs[2] (det of their normals > 0 for all
+/// but `det`); v, when hs has 7 half-spaces, that of hs[4], hs[5] and hs[6].
 PreciseProbe probe_precise(const std::vector<HalfSpace>& hs);
 /// The rounding of a point known exactly, X / W (W > 0), as an erosion's known points.
 PreciseProbe probe_precise_point(const V3<ExactN>& X, const ExactN& W);
+/// For tests (not while an intersection runs): whether the precise stage forms its
+/// products' error terms by fused multiply-adds (the default where the processor has them)
+/// or Dekker's splits; the same results either way. Returns whether the processor has FMA.
+bool set_precise_fma(bool use);
 
 /// For tests: the double filter alone (the first stage of the vertices' tests, before
 /// intervals), on hs as probe_precise's: 1 where it finds W = det(n_0, n_1, n_2) > 0 (`w`),
