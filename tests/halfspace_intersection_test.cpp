@@ -997,46 +997,6 @@ std::vector<HalfSpace> moved_fourth(const V3<ExactN>& p, int scale, int q_scale,
 
 }  // namespace
 
-// The precise stage's fused multiply-add arithmetic (where the processor has it) gives what
-// Dekker's splits give: the same roundings decided, to the same doubles, and the same signs,
-// on adversarial points, tilted and scaled planes.
-TEST_CASE("halfspace_intersection: the precise stage is the same with and without FMA") {
-  if (!set_precise_fma(true)) {
-    MESSAGE("no FMA on this processor: one route only");
-    return;
-  }
-  int compared = 0;
-  for (const auto& [p, k] : adversarial_points()) {
-    for (int scale : {0, -200, 200}) {
-      for (double tilt : {0.0, 0x1p-20, 0x1p-45}) {
-        const V3<double> n0{1, 0.25, -0.5}, n1{-0.3, 1, 0.1};
-        const V3<double> n2 =
-            tilt == 0 ? V3<double>{0.2, -0.7, 1} : V3<double>{n0.x + tilt, n0.y - tilt, n0.z};
-        for (int bits : {30, 90}) {
-          V3<ExactN> q;
-          std::vector<HalfSpace> hs = moved_fourth(p, scale, -scale, bits, 1, q);
-          const std::vector<HalfSpace> tilted = three_through(n0, n1, n2, p, scale);
-          for (int i = 0; i < 3; ++i) hs[i] = tilted[i];
-          set_precise_fma(true);
-          const PreciseProbe fused = probe_precise(hs);
-          set_precise_fma(false);
-          const PreciseProbe split = probe_precise(hs);
-          set_precise_fma(true);
-          CHECK(fused.decided == split.decided);
-          CHECK(fused.side == split.side);
-          CHECK(fused.compare == split.compare);
-          const double f[3] = {fused.rounded.x, fused.rounded.y, fused.rounded.z},
-                       d[3] = {split.rounded.x, split.rounded.y, split.rounded.z};
-          for (int i = 0; i < 3; ++i)
-            if (fused.decided[i] && split.decided[i]) CHECK(same_double(f[i], d[i]));
-          compared += fused.decided[0] + fused.decided[1] + fused.decided[2];
-        }
-      }
-    }
-  }
-  CHECK(compared > 100);
-}
-
 // The precise stage's determinant of three normals (the repair's and the guess's
 // orientation tests, after intervals): nearly coplanar normals, n_2 = n_0 + n_1 moved by
 // 2^-k, decided as the exact sign down to 2^-80 relative, of either sign, and exactly

@@ -585,97 +585,18 @@ PrecisePlane precise_plane(const Plane& plane) {
 V3<DD> normal_dd(const PrecisePlane& p) { return {p.c[0], p.c[1], p.c[2]}; }
 V3<Magnitude> normal_magnitude(const PrecisePlane& p) { return magnitude(normal_dd(p)); }
 
-/// Double-double arithmetic as exact.h's, but for a product's error term: one fused
-/// multiply-add instead of Dekker's splits, on processors with FMA (has_fma). Both are
-/// a b - hi exactly (while no partial product underflows; below that both err by less than
-/// the absolute terms of the bounds), so the results, and the decisions, are the same.
-struct FmaDD {
-  double hi, lo;
-};
-[[gnu::target("fma"), gnu::optimize("fp-contract=off")]] inline FmaDD operator+(const FmaDD& a,
-                                                                                const FmaDD& b) {
-  const DD s = two_sum(a.hi, b.hi);
-  const DD r = quick_two_sum(s.hi, s.lo + (a.lo + b.lo));
-  return {r.hi, r.lo};
-}
-[[gnu::target("fma"), gnu::optimize("fp-contract=off")]] inline FmaDD operator-(const FmaDD& a) {
-  return {-a.hi, -a.lo};
-}
-[[gnu::target("fma"), gnu::optimize("fp-contract=off")]] inline FmaDD operator-(const FmaDD& a,
-                                                                                const FmaDD& b) {
-  return a + -b;
-}
-[[gnu::target("fma"), gnu::optimize("fp-contract=off")]] inline FmaDD operator*(const FmaDD& a,
-                                                                                const FmaDD& b) {
-  const double p = a.hi * b.hi;
-  const DD r = quick_two_sum(p, __builtin_fma(a.hi, b.hi, -p) + (a.hi * b.lo + a.lo * b.hi));
-  return {r.hi, r.lo};
-}
-const bool cpu_has_fma = __builtin_cpu_supports("fma");
-bool has_fma = cpu_has_fma;  // (set_precise_fma: tests compare both)
-/// two_prod by a fused multiply-add: a b = hi + lo exactly (as Dekker's, in fewer operations).
-[[gnu::target("fma"), gnu::optimize("fp-contract=off")]] inline DD fma_two_prod(double a,
-                                                                                double b) {
-  const double p = a * b;
-  return {p, __builtin_fma(a, b, -p)};
-}
-
-template <class D>
-V3<D> as(const V3<DD>& v) {
-  return {{v.x.hi, v.x.lo}, {v.y.hi, v.y.lo}, {v.z.hi, v.z.lo}};
-}
-template <class D>
-V3<DD> from(const V3<D>& v) {
-  return {{v.x.hi, v.x.lo}, {v.y.hi, v.y.lo}, {v.z.hi, v.z.lo}};
-}
-
 /// n x m in double-double, its operations inlined (these run for most vertices; the
-/// arithmetic is exact.h's, or FmaDD's, so are the results and bounds).
-template <class D>
-V3<DD> cross_in(const V3<DD>& n, const V3<DD>& m) {
-  return from(cross(as<D>(n), as<D>(m)));
-}
-[[gnu::flatten]] V3<DD> cross_plain(const V3<DD>& n, const V3<DD>& m) { return cross_in<DD>(n, m); }
-[[gnu::flatten, gnu::target("fma"), gnu::optimize("fp-contract=off")]] V3<DD> cross_fma(
-    const V3<DD>& n, const V3<DD>& m) {
-  return cross_in<FmaDD>(n, m);
-}
-V3<DD> cross_dd(const V3<DD>& n, const V3<DD>& m) {
-  return has_fma ? cross_fma(n, m) : cross_plain(n, m);
-}
+/// arithmetic is exact.h's, so are the results and bounds).
+[[gnu::flatten]] V3<DD> cross_dd(const V3<DD>& n, const V3<DD>& m) { return cross(n, m); }
 
 /// The precise meet of valid planes a, b, c (round-to-nearest) from their normals' cross
 /// products bc, ca, ab in double-double, each as `cross` evaluates it or that negated (the
 /// same value of the opposite edge, n_b x n_a = -(n_a x n_b): negation is exact, so the
 /// bound below holds alike).
-template <class D>
-void meet_in(const PrecisePlane& a, const PrecisePlane& b, const PrecisePlane& c, const V3<DD>& bc,
-             const V3<DD>& ca, const V3<DD>& ab, HVertex& v) {
-  const auto one = [](const DD& x) { return D{x.hi, x.lo}; };
-  V3<D> X;
-  D W;
-  meet_of_crosses(as<D>(normal_dd(a)), one(a.c[3]), one(b.c[3]), one(c.c[3]), as<D>(bc), as<D>(ca),
-                  as<D>(ab), X, W);
-  v.px = from(X);
-  v.pw = {W.hi, W.lo};
-}
-[[gnu::flatten]] void meet_plain(const PrecisePlane& a, const PrecisePlane& b,
-                                 const PrecisePlane& c, const V3<DD>& bc, const V3<DD>& ca,
-                                 const V3<DD>& ab, HVertex& v) {
-  meet_in<DD>(a, b, c, bc, ca, ab, v);
-}
-[[gnu::flatten, gnu::target("fma"), gnu::optimize("fp-contract=off")]] void meet_fma(
-    const PrecisePlane& a, const PrecisePlane& b, const PrecisePlane& c, const V3<DD>& bc,
-    const V3<DD>& ca, const V3<DD>& ab, HVertex& v) {
-  meet_in<FmaDD>(a, b, c, bc, ca, ab, v);
-}
 [[gnu::flatten]] void precise_meet(const PrecisePlane& a, const PrecisePlane& b,
                                    const PrecisePlane& c, const V3<DD>& bc, const V3<DD>& ca,
                                    const V3<DD>& ab, HVertex& v) {
-  if (has_fma)
-    meet_fma(a, b, c, bc, ca, ab, v);
-  else
-    meet_plain(a, b, c, bc, ca, ab, v);
+  meet_of_crosses(normal_dd(a), a.c[3], b.c[3], c.c[3], bc, ca, ab, v.px, v.pw);
   V3<Magnitude> mx;
   Magnitude mw;
   meet(normal_magnitude(a), magnitude(a.c[3]), normal_magnitude(b), magnitude(b.c[3]),
@@ -1023,17 +944,15 @@ double step_away(double r, bool away) {
 /// (any double serves: it only proposes candidates, which are checked), computed once for a
 /// vertex's three coordinates: multiplications instead of two divisions each, whose latency
 /// showed in the rounding loop's profile.
-template <bool kFma>
-inline bool round_precise_in(const DD& X, double ex, const DD& W, double ew, double inverse,
-                             double& out) {
+[[gnu::flatten]] bool round_precise(const DD& X, double ex, const DD& W, double ew, double inverse,
+                                    double& out) {
   if (!(W.hi >= 0x1p-300 && W.hi <= 0x1p300) || !(ew <= 0x1p-60 * W.hi)) return false;
-  // The residual R = X - r W in double-double: the product r W.hi is exact (Dekker, or one
-  // fused multiply-add: the same value), and so is the cancelling X.hi - p.hi; what remains
-  // is small. `sum` bounds those small terms, whose three additions and the last one err by
-  // 2^-53 of them each.
+  // The residual R = X - r W in double-double: the product r W.hi is exact (Dekker), and
+  // so is the cancelling X.hi - p.hi; what remains is small. `sum` bounds those small
+  // terms, whose three additions and the last one err by 2^-53 of them each.
   double sum = 0;
   const auto residual = [&](double r) {
-    const DD p = kFma ? fma_two_prod(r, W.hi) : two_prod(r, W.hi), s = two_sum(X.hi, -p.hi);
+    const DD p = two_prod(r, W.hi), s = two_sum(X.hi, -p.hi);
     const double q = r * W.lo;
     sum = std::abs(s.lo) + std::abs(X.lo) + std::abs(p.lo) + std::abs(q);
     return s.hi + (((s.lo + X.lo) - p.lo) - q);
@@ -1064,18 +983,6 @@ inline bool round_precise_in(const DD& X, double ex, const DD& W, double ew, dou
   if (!rounds_to(r, residual(r))) return false;
   out = r;
   return true;
-}
-[[gnu::flatten]] bool round_precise_plain(const DD& X, double ex, const DD& W, double ew,
-                                          double inverse, double& out) {
-  return round_precise_in<false>(X, ex, W, ew, inverse, out);
-}
-[[gnu::flatten, gnu::target("fma"), gnu::optimize("fp-contract=off")]] bool round_precise_fma(
-    const DD& X, double ex, const DD& W, double ew, double inverse, double& out) {
-  return round_precise_in<true>(X, ex, W, ew, inverse, out);
-}
-bool round_precise(const DD& X, double ex, const DD& W, double ew, double inverse, double& out) {
-  return has_fma ? round_precise_fma(X, ex, W, ew, inverse, out)
-                 : round_precise_plain(X, ex, W, ew, inverse, out);
 }
 
 int det_sign(const Plane& a, const Plane& b, const Plane& c) {
@@ -2521,11 +2428,6 @@ void probe_rounding(const HVertex& v, PreciseProbe& out) {
 }
 
 }  // namespace
-
-bool set_precise_fma(bool use) {
-  has_fma = use && cpu_has_fma;
-  return cpu_has_fma;
-}
 
 PreciseProbe probe_precise(const std::vector<HalfSpace>& hs) {
   const std::vector<Plane> planes = planes_of(hs);

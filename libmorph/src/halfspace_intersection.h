@@ -42,7 +42,8 @@ struct HalfSpace {
 /// Sets h.normal_dd from h.normal = (p1 - p0) x (p2 - p0) for a triangle of double points
 /// (its Newell normal), when the differences are exact in doubles and the products and the
 /// bound allow; leaves h unchanged otherwise.
-void set_normal_dd(HalfSpace& h, const V3<double>& p0, const V3<double>& p1, const V3<double>& p2);
+void set_normal_dd(HalfSpace& h, const V3<double>& p0, const V3<double>& p1,
+                   const V3<double>& p2);
 
 /// The half-space <normal, x> <= offset for any rational offset.
 HalfSpace make_halfspace(const V3<ExactN>& normal, const Exact& offset, int source);
@@ -168,10 +169,6 @@ struct PreciseProbe {
 PreciseProbe probe_precise(const std::vector<HalfSpace>& hs);
 /// The rounding of a point known exactly, X / W (W > 0), as an erosion's known points.
 PreciseProbe probe_precise_point(const V3<ExactN>& X, const ExactN& W);
-/// For tests (not while an intersection runs): whether the precise stage forms its
-/// products' error terms by fused multiply-adds (the default where the processor has them)
-/// or Dekker's splits; the same results either way. Returns whether the processor has FMA.
-bool set_precise_fma(bool use);
 
 /// For tests: the double filter alone (the first stage of the vertices' tests, before
 /// intervals), on hs as probe_precise's: 1 where it finds W = det(n_0, n_1, n_2) > 0 (`w`),
