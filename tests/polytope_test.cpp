@@ -668,6 +668,31 @@ TEST_CASE("polytope: the check's shortcut past proven edges keeps its verdict ne
   CHECK(accepted > 0);
 }
 
+TEST_CASE("polytope: the check skips a triangle's own planarity heights only when it may") {
+  // A triangle skips the planarity test of its own corners when StrictBelow's bound on their
+  // heights (zero exactly) is within the tolerance. Far from the origin the heights round more
+  // coarsely than the tolerance of a small mesh, and the test rejects it as not planar: the
+  // bound grows with the coordinates, so the skip must not hide that, nor anything else.
+  const Mesh sphere = morph::read_mesh(std::string(MORPH_SAMPLES_DIR) + "/icosphere_80.off");
+  int rejected = 0, accepted = 0, not_planar = 0;
+  for (const double scale : {1.0, 1e-3}) {
+    for (int k = 0; k <= 52; k += 4) {
+      const double far = k == 0 ? 0.0 : std::ldexp(1.0, k);
+      const Mesh moved =
+          morph::test::translated(morph::test::scaled(sphere, scale), Point(far, -far / 3, far));
+      CAPTURE(scale);
+      CAPTURE(k);
+      const std::string problem = morph::check_convex_polyhedron(moved).problem;
+      CHECK(geometry_check_passes(moved) == problem.empty());
+      (problem.empty() ? accepted : rejected) += 1;
+      if (problem.find("is not planar") != std::string::npos) not_planar += 1;
+    }
+  }
+  CHECK(accepted > 0);  // both verdicts occur, the rejection by the planarity test among them
+  CHECK(not_planar > 0);
+  CHECK(rejected >= not_planar);
+}
+
 namespace {
 
 // Whether unit normal u lies within u.error of the direction of the exact normal n, decided

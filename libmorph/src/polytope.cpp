@@ -950,12 +950,21 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   return mesh_edge;
 }
 
+// Whether any of these status flags marks its element deleted: the flags or-ed together, a loop
+// without exits that the compiler vectorises (almost every mesh has none deleted, so any_of's
+// early exit would not pay for its branch per element).
+template <class Statuses>
+bool any_status_deleted(const Statuses& status) {
+  unsigned bits = 0;
+  for (const auto& s : status) bits |= s.bits();
+  return (bits & OpenMesh::Attributes::DELETED) != 0;
+}
+
 // Whether any vertex, edge or face is marked deleted (read straight from the status
 // arrays: OpenMesh's status() looks the property up on every call).
 bool has_deleted_elements(const Mesh& mesh) {
   const auto any_deleted = [&](const auto& status_handle) {
-    const auto& status = mesh.property(status_handle).data_vector();
-    return std::any_of(status.begin(), status.end(), [](const auto& s) { return s.deleted(); });
+    return any_status_deleted(mesh.property(status_handle).data_vector());
   };
   return (mesh.has_vertex_status() && any_deleted(mesh.vertex_status_pph())) ||
          (mesh.has_edge_status() && any_deleted(mesh.edge_status_pph())) ||
@@ -1196,16 +1205,24 @@ Polytope finish_from_halfedges(Polytope& p, std::vector<int> mesh_edge, const Me
 constexpr int kParallelOperandFaces = 1000;
 
 /// The mesh's points into p, and whether the mesh is readable() (every coordinate finite),
-/// in one pass.
-bool copy_points(Polytope& p, const Mesh& mesh) {
+/// in one pass; with `box`, also the points' bounding box as the operand check computes it (see
+/// geometry_passes).
+bool copy_points(Polytope& p, const Mesh& mesh, PointBox* box = nullptr) {
   p.points.resize(mesh.n_vertices());
   const Point* q = mesh.points();
   bool finite = true;
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  Point lo(inf, inf, inf), hi(-inf, -inf, -inf);
   for (int v = 0; v < p.num_vertices(); ++v) {
     const V3<double> x{q[v][0], q[v][1], q[v][2]};
     finite &= std::isfinite(x.x) & std::isfinite(x.y) & std::isfinite(x.z);
     p.points[v] = x;
+    if (box) {
+      lo.minimize(q[v]);
+      hi.maximize(q[v]);
+    }
   }
+  if (box) *box = {lo, hi};
   return finite;
 }
 
@@ -1219,13 +1236,13 @@ bool copy_points(Polytope& p, const Mesh& mesh) {
 /// messages. The polytope is make_polytope(mesh, name)'s, built by the same code.
 std::optional<Polytope> checked_polytope(const Mesh& mesh, const char* name) {
   if (mesh.n_faces() == 0 || has_deleted_elements(mesh)) return std::nullopt;
-  if (mesh.has_halfedge_status()) {  // the check counts only live halfedges
-    const auto& status = mesh.property(mesh.halfedge_status_pph()).data_vector();
-    if (std::any_of(status.begin(), status.end(), [](const auto& s) { return s.deleted(); }))
-      return std::nullopt;
-  }
+  // The check counts only live halfedges.
+  if (mesh.has_halfedge_status() &&
+      any_status_deleted(mesh.property(mesh.halfedge_status_pph()).data_vector()))
+    return std::nullopt;
   Polytope p;
-  if (!copy_points(p, mesh)) return std::nullopt;
+  PointBox box;
+  if (!copy_points(p, mesh, &box) || p.num_vertices() == 0) return std::nullopt;
   OperandTopology topology;
   std::vector<int> mesh_edge;
   // The halfedge walks; false when they meet a broken face cycle or fan (the check names it).
@@ -1277,7 +1294,8 @@ std::optional<Polytope> checked_polytope(const Mesh& mesh, const char* name) {
     if (!walked) return std::nullopt;
     const FaceCycleView cycles{p.face_begin.data(), p.corner_vertex.data(), topology.across.data()};
     p.unit_normals.resize(p.num_faces());
-    passes = geometry_passes(mesh, cycles, p.unit_normals.data(), units_known, edges_convex);
+    passes =
+        geometry_passes(mesh, cycles, p.unit_normals.data(), units_known, edges_convex, &box);
     rejected = !passes;
     build();
   }

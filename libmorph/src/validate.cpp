@@ -110,6 +110,8 @@ struct Extent {
   Point centre{0, 0, 0};
 };
 
+Extent extent_of(const Point& lo, const Point& hi) { return {(hi - lo).norm(), (lo + hi) * 0.5}; }
+
 Extent bounding_box(const MeshView& m) {
   constexpr double inf = std::numeric_limits<double>::infinity();
   Point lo(inf, inf, inf), hi(-inf, -inf, -inf);
@@ -121,7 +123,7 @@ Extent bounding_box(const MeshView& m) {
     any = true;
   }
   if (!any) return {};
-  return {(hi - lo).norm(), (lo + hi) * 0.5};
+  return extent_of(lo, hi);
 }
 
 // The vertex cycle of every live face, in the order of its vertex circulator (starting
@@ -345,6 +347,8 @@ struct Geometry {
   bool unit_complete = true;
   // With `unit`: whether every edge is proven strictly convex (see StrictBelow).
   bool edges_proven = false;
+  // Optional (null: none): the caller's bounding box of the vertices (see geometry_passes).
+  const detail::PointBox* box = nullptr;
 };
 
 // A proof that an edge between two triangles is strictly convex, from the reflex test's height
@@ -532,7 +536,12 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, const S
   const Point &p0 = m.points[i0], &p1 = m.points[i1], &p2 = m.points[i2];
   // height(plane, p): dot(p - centroid, normal), summed in OpenMesh's order.
   const PlaneHeight height{q.cx, q.cy, q.cz, q.nx, q.ny, q.nz};
-  if (non_planar_face < 0 &&
+  // With kProve, StrictBelow's bound on how far a height here is from the signed distance to the
+  // exact plane, e_f W + K (infinite when the unit normal proves nothing). The corners lie in
+  // that plane: when the bound is within the tolerance, so are their heights.
+  const double bound =
+      kProve && unit ? -strict.threshold(unit[f].error) : std::numeric_limits<double>::infinity();
+  if (non_planar_face < 0 && !(bound <= tolerance) &&
       !(std::abs(height(p0)) <= tolerance && std::abs(height(p1)) <= tolerance &&
         std::abs(height(p2)) <= tolerance))
     non_planar_face = f;
@@ -542,12 +551,12 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, const S
   const int* across = cycles.across + b;
   const int from[3] = {i2, i0, i1}, to[3] = {i0, i1, i2};
   bool reflex = false, polygon_across = false, below = true;
-  const double threshold = kProve && proven ? strict.threshold(unit[f].error) : 0;
+  const double threshold = kProve && proven ? -bound : 0;
   // While every edge met so far is proven, an edge to an earlier face g was proven by g's heights
   // (a triangle, as every face so far): strictly convex, so the far corner v of g lies strictly
-  // below f's exact plane and its height here is below e_f W + K = -threshold (StrictBelow's
-  // bound); when that is within the tolerance, the reflex test would pass and is skipped.
-  const bool skip_earlier = kProve && proven && -threshold <= tolerance;
+  // below f's exact plane and its height here is below the bound; when that is within the
+  // tolerance, the reflex test would pass and is skipped.
+  const bool skip_earlier = kProve && proven && bound <= tolerance;
   for (int k = 0; k < 3; ++k) {
     const int g = across[k];
     if (skip_earlier && g < f) continue;
@@ -701,7 +710,7 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
       return fail(Verdict::invalid,
                   "vertex " + std::to_string(v) + " has a coordinate that is not finite");
   }
-  geometry.extent = bounding_box(m);
+  geometry.extent = geometry.box ? extent_of(geometry.box->lo, geometry.box->hi) : bounding_box(m);
   const double diagonal = geometry.extent.diagonal;
   if (!(diagonal >= kMinSize && diagonal <= kMaxSize))
     return fail(Verdict::invalid, "the mesh's size (bounding-box diagonal " + number(diagonal) +
@@ -984,10 +993,11 @@ bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles, double plana
 }
 
 bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles, UnitNormal* unit_normals,
-                     bool& complete, bool& edges_convex) {
+                     bool& complete, bool& edges_convex, const PointBox* box) {
   const MeshView m(mesh, true);  // the caller's precondition
   Geometry geometry = on_cycles(cycles);
   geometry.unit = unit_normals;
+  geometry.box = box;
   // The proof needs every face a triangle (it gives up at any other): only then is it tried.
   const bool triangles = cycles.begin[m.n_faces] == 3LL * m.n_faces;
   const bool passes = geometry_of_cycles_passes(m, geometry, kPlanarityTolerance, triangles);

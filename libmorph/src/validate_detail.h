@@ -89,8 +89,14 @@ struct UnitNormal;  // polytope.h
 /// triangle and every edge is proven strictly convex (the far corner of each triangle across
 /// lies strictly below the exact plane of the face, told from the heights the reflex test
 /// computes): then so is every edge of the polytope with these facets.
+/// `box`, when given: the mesh's bounding box, lo and hi minimised and maximised (Point's
+/// minimize, maximize) over the vertices in index order from +-infinity, as the checks would
+/// compute it (then they do not read the points again for it). The mesh has a vertex.
+struct PointBox {
+  Point lo, hi;
+};
 bool geometry_passes(const Mesh& mesh, const FaceCycleView& cycles, UnitNormal* unit_normals,
-                     bool& complete, bool& edges_convex);
+                     bool& complete, bool& edges_convex, const PointBox* box = nullptr);
 
 /// geometry_passes(mesh, cycles) on the face cycles read here from the mesh (check_operand's),
 /// for a caller that checks beside the halfedge walks that would give them: the same verdict
