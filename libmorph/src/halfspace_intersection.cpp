@@ -611,57 +611,74 @@ V3<Magnitude> normal_magnitude(const PrecisePlane& p) { return magnitude(normal_
   v.precise = true;
 }
 
-/// The precise coordinates of a vertex (round-to-nearest): a known point's from its exact
-/// ones (W in [1, 2)), another's as the meet of its precise planes (`crosses`: their
-/// normals' cross products bc, ca, ab when the caller has them, as in precise_meet). Left
-/// out when a plane is not valid or a value out of range.
+/// One-time initialisations by index: call(i, f) runs f once for each i, in whichever thread
+/// asks first, the others waiting for it. std::call_once makes a futex system call each time
+/// it runs f (glibc wakes waiters unconditionally), which cost more than most of what it
+/// guarded (a plane's precise copy, a vertex's exact coordinates).
+class OnceFlags {
+ public:
+  explicit OnceFlags(std::size_t n) : state_(std::make_unique<std::atomic<unsigned char>[]>(n)) {}
+  template <class F>
+  void call(std::size_t i, const F& f) const {
+    if (state_[i].load(std::memory_order_acquire) != kDone) run(i, f);
+  }
+  /// Whether f has run for i already.
+  bool done(std::size_t i) const { return state_[i].load(std::memory_order_acquire) == kDone; }
+
+ private:
+  static constexpr unsigned char kNone = 0, kRunning = 1, kDone = 2;
+  // A claim whose run throws (out of memory) is given back before the exception leaves: a
+  // thread waiting for it then claims it in turn (and runs f, or meets the error itself)
+  // instead of waiting forever for a value nobody is making. (run is not inlined, which
+  // keeps call small enough to inline.)
+  template <class F>
+  [[gnu::noinline]] void run(std::size_t i, const F& f) const {
+    for (;;) {
+      unsigned char expected = kNone;
+      if (state_[i].compare_exchange_strong(expected, kRunning, std::memory_order_acquire)) {
+        try {
+          f();
+        } catch (...) {
+          state_[i].store(kNone, std::memory_order_release);
+          throw;
+        }
+        state_[i].store(kDone, std::memory_order_release);
+        return;
+      }
+      if (expected == kDone) return;
+      std::this_thread::yield();
+    }
+  }
+  std::unique_ptr<std::atomic<unsigned char>[]> state_;  // value-initialised: kNone
+};
+
 /// The planes' precise copies, each made when a filter first needs it, by whichever thread
 /// needs it first (the copy does not depend on the thread, so neither does any decision).
 /// Shared by every stage of an intersection: the flips, each check, the incremental hull.
 class PrecisePlanes {
  public:
   explicit PrecisePlanes(const std::vector<Plane>& planes)
-      : planes_(planes),
-        precise_(planes.size()),
-        state_(std::make_unique<std::atomic<unsigned char>[]>(planes.size())) {}
+      : planes_(planes), precise_(planes.size()), once_(planes.size()) {}
   const PrecisePlane& operator[](int i) const {  // any rounding mode
-    if (state_[i].load(std::memory_order_acquire) != kMade) make(i);
+    once_.call(i, [&] {
+      CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+      precise_[i] = precise_plane(planes_[i]);
+    });
     return precise_[i];
   }
   /// Whether plane i's copy is made already (a test that may use it costs no conversion).
-  bool made(int i) const { return state_[i].load(std::memory_order_acquire) == kMade; }
+  bool made(int i) const { return once_.done(i); }
 
  private:
-  // Each plane's state: not made, being made (by the thread that claimed it), made. A flag
-  // of our own: std::call_once costs more than most of the copies it guards.
-  static constexpr unsigned char kNone = 0, kMaking = 1, kMade = 2;
-  // A claim whose making throws (out of memory) is given back before the exception leaves:
-  // a thread waiting for the plane then claims it in turn (and makes it, or meets the error
-  // itself) instead of waiting forever for a copy nobody is making.
-  [[gnu::noinline]] void make(int i) const {  // (keeps operator[] small enough to inline)
-    for (;;) {
-      unsigned char expected = kNone;
-      if (state_[i].compare_exchange_strong(expected, kMaking, std::memory_order_acquire)) {
-        try {
-          CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
-          precise_[i] = precise_plane(planes_[i]);
-        } catch (...) {
-          state_[i].store(kNone, std::memory_order_release);
-          throw;
-        }
-        state_[i].store(kMade, std::memory_order_release);
-        return;
-      }
-      if (expected == kMade) return;  // the failed exchange read it (with acquire order)
-      std::this_thread::yield();
-    }
-  }
-
   const std::vector<Plane>& planes_;
-  mutable std::vector<PrecisePlane> precise_;  // each written once, by its claiming thread
-  std::unique_ptr<std::atomic<unsigned char>[]> state_;
+  mutable std::vector<PrecisePlane> precise_;  // each written once, under its flag in once_
+  OnceFlags once_;
 };
 
+/// The precise coordinates of a vertex (round-to-nearest): a known point's from its exact
+/// ones (W in [1, 2)), another's as the meet of its precise planes (`crosses`: their
+/// normals' cross products bc, ca, ab when the caller has them, as in precise_meet). Left
+/// out when a plane is not valid or a value out of range.
 void make_precise(const PrecisePlanes& planes, HVertex& v,
                   const std::array<V3<DD>, 3>* crosses = nullptr) {
   v.precise_tried = true;
@@ -873,42 +890,6 @@ int compare_filter(const std::vector<Plane>& planes, const PrecisePlanes& precis
 int compare_exact(const Plane& p, const HVertex& u, const HVertex& v) {
   return CGAL::sign(dot(*p.n, *u.X) * *v.W - dot(*p.n, *v.X) * *u.W);
 }
-
-/// One-time initialisations by index: call(i, f) runs f once for each i, in whichever thread
-/// asks first, the others waiting for it (as PrecisePlanes' flags). std::call_once makes a
-/// futex system call each time it runs f (glibc wakes waiters unconditionally), which cost
-/// more than the rounding it guarded.
-class OnceFlags {
- public:
-  explicit OnceFlags(std::size_t n) : state_(std::make_unique<std::atomic<unsigned char>[]>(n)) {}
-  template <class F>
-  void call(std::size_t i, const F& f) const {
-    if (state_[i].load(std::memory_order_acquire) != kDone) run(i, f);
-  }
-
- private:
-  static constexpr unsigned char kNone = 0, kRunning = 1, kDone = 2;
-  // As PrecisePlanes::make: a run that throws gives its claim back.
-  template <class F>
-  [[gnu::noinline]] void run(std::size_t i, const F& f) const {
-    for (;;) {
-      unsigned char expected = kNone;
-      if (state_[i].compare_exchange_strong(expected, kRunning, std::memory_order_acquire)) {
-        try {
-          f();
-        } catch (...) {
-          state_[i].store(kNone, std::memory_order_release);
-          throw;
-        }
-        state_[i].store(kDone, std::memory_order_release);
-        return;
-      }
-      if (expected == kDone) return;
-      std::this_thread::yield();
-    }
-  }
-  std::unique_ptr<std::atomic<unsigned char>[]> state_;  // value-initialised: kNone
-};
 
 /// Exact vertex coordinates made on first use, by whichever thread needs them first (each
 /// at most once; they do not depend on the thread, so neither does any decision).
