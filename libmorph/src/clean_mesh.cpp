@@ -287,7 +287,11 @@ FacetGeometry geometry(const std::vector<V3<double>>& points, const Soup& soup, 
 
 /// v + 0 componentwise: v, with zeros made positive (as 0 + v, which `geometry`'s sums start
 /// with).
-V3<double> plus_zero(const V3<double>& v) { return {v.x + 0.0, v.y + 0.0, v.z + 0.0}; }
+/// Also per lane, for geometry_pair's pairs (a double added to a Pair goes to both lanes).
+template <class T>
+V3<T> plus_zero(const V3<T>& v) {
+  return {v.x + 0.0, v.y + 0.0, v.z + 0.0};
+}
 
 /// The finite limit that the sums' checks below compare with (NaN and infinities fail).
 constexpr double kLargest = std::numeric_limits<double>::max();
@@ -350,9 +354,6 @@ void geometry_pair(const std::vector<V3<double>>& points, const Soup& soup, int 
     return V3<Pair>{Pair{p.x, q.x}, Pair{p.y, q.y}, Pair{p.z, q.z}};
   };
   const Pair zero{0, 0};
-  const auto plus_zero = [&](const V3<Pair>& a) {
-    return V3<Pair>{a.x + zero, a.y + zero, a.z + zero};
-  };
   const V3<Pair> origin = load(0), q1 = load(1) - origin, q2 = load(2) - origin;
   V3<Pair> sum, centroid;
   Pair longest_squared;
