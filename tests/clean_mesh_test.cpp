@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <map>
 #include <set>
 #include <string>
@@ -727,4 +728,80 @@ TEST_CASE("clean_mesh finds the planes of consecutive facets two at a time") {
       for (auto f : mesh.faces()) valences.insert(mesh.valence(f));
       CHECK(valences == std::multiset<std::size_t>{4, 4, 4, 4, 4, 5, 5});
     }
+}
+
+// A cone over a regular n-gon at height `z` (1 or -1) with its apex at the origin: the base
+// (n corners) and n triangles, outward, as one soup of points `first` on (apex: point 0).
+void add_cone(int n, double z, std::vector<V3<double>>& points, std::vector<int>& begin,
+              std::vector<int>& corners) {
+  const int first = static_cast<int>(points.size());
+  for (int i = 0; i < n; ++i) {
+    const double angle = 2 * 3.141592653589793 * i / n;
+    points.push_back({std::cos(angle), std::sin(angle), z});
+  }
+  const auto add = [&](const std::vector<int>& f) {
+    corners.insert(corners.end(), f.begin(), f.end());
+    begin.push_back(static_cast<int>(corners.size()));
+  };
+  std::vector<int> base;
+  for (int i = 0; i < n; ++i) base.push_back(first + (z > 0 ? i : n - 1 - i));
+  add(base);
+  for (int i = 0; i < n; ++i) {
+    const int here = first + i, after = first + (i + 1) % n;
+    add(z > 0 ? std::vector<int>{0, after, here} : std::vector<int>{0, here, after});
+  }
+}
+
+// The apex has n corners around it and the base n corners: the counts that `connect` and
+// `build` take by unrolled code (3 to 8 around a vertex, 3 and 4 in a face) and the others.
+// Two cones on one apex give it two fans (2n corners around it): not a manifold, so the hull.
+TEST_CASE("clean_mesh joins cones of any number of corners around the apex and in the base") {
+  for (int n = 3; n <= 12; ++n) {
+    CAPTURE(n);
+    std::vector<V3<double>> points{{0, 0, 0}};
+    std::vector<int> begin{0}, corners, source;
+    add_cone(n, 1, points, begin, corners);
+    const std::vector<int> given = corners, given_begin = begin;
+    const long before = morph::detail::clean_mesh_hull_fallbacks();
+    const morph::Mesh mesh = clean_mesh(points, begin, corners, &source);
+    CHECK(morph::detail::clean_mesh_hull_fallbacks() == before);
+    CHECK(mesh.n_vertices() == static_cast<std::size_t>(n + 1));
+    CHECK(mesh.n_edges() == static_cast<std::size_t>(2 * n));
+    REQUIRE(mesh.n_faces() == static_cast<std::size_t>(n + 1));
+    REQUIRE(source.size() == mesh.n_faces());
+    for (auto h : mesh.halfedges()) {
+      CHECK_FALSE(mesh.is_boundary(h));
+      CHECK(mesh.prev_halfedge_handle(mesh.next_halfedge_handle(h)) == h);
+      const auto o = mesh.opposite_halfedge_handle(h);
+      CHECK(mesh.from_vertex_handle(h) == mesh.to_vertex_handle(o));
+      CHECK(mesh.face_handle(h) != mesh.face_handle(o));
+      CHECK(mesh.face_handle(mesh.next_halfedge_handle(h)) == mesh.face_handle(h));
+    }
+    for (auto v : mesh.vertices()) CHECK(mesh.from_vertex_handle(mesh.halfedge_handle(v)) == v);
+    // Each face is its facet's cycle, from the facet's first corner, with its source.
+    for (auto f : mesh.faces()) {
+      const int s = source[f.idx()];
+      REQUIRE(s == f.idx());
+      std::vector<int> cycle;
+      auto h = mesh.halfedge_handle(f);
+      for (int i = 0; i < given_begin[s + 1] - given_begin[s]; ++i) {
+        cycle.push_back(mesh.to_vertex_handle(h).idx());
+        h = mesh.next_halfedge_handle(h);
+      }
+      CHECK(h == mesh.halfedge_handle(f));
+      CHECK(cycle == std::vector<int>(given.begin() + given_begin[s],
+                                      given.begin() + given_begin[s + 1]));
+    }
+  }
+  for (int n = 3; n <= 5; ++n) {
+    CAPTURE(n);
+    std::vector<V3<double>> points{{0, 0, 0}};
+    std::vector<int> begin{0}, corners, source;
+    add_cone(n, 1, points, begin, corners);
+    add_cone(n, -1, points, begin, corners);
+    const long before = morph::detail::clean_mesh_hull_fallbacks();
+    const morph::Mesh mesh = clean_mesh(points, begin, corners, &source);
+    CHECK(morph::detail::clean_mesh_hull_fallbacks() == before + 1);
+    CHECK(mesh.n_vertices() == static_cast<std::size_t>(2 * n));  // the apex is inside
+  }
 }

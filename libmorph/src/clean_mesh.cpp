@@ -33,6 +33,7 @@
 #include <numeric>
 #include <optional>
 #include <queue>
+#include <type_traits>
 
 #include "fims.h"
 #include "parallel.h"
@@ -131,6 +132,42 @@ Connectivity facet_cycles(const Soup& soup) {
   return k;
 }
 
+/// A corner leaving a vertex, with what the vertex's fan in `connect` reads of it: the point
+/// its edge goes to, and the corner before it (whose edge ends at the vertex) with that
+/// corner's point.
+struct OutCorner {
+  int corner, to, before, from;
+};
+
+/// `connect`'s fan of a vertex with N outgoing corners `o` (at place `b` of its counting
+/// sort), N known at compile time: the loops are unrolled and the walk around the vertex
+/// takes its N steps without a branch. The vertices' numbers of corners follow no pattern,
+/// and the exits of loops of that many steps were mispredicted about once per loop and
+/// vertex. The same result as the loops of any length (see `connect`).
+template <int N>
+bool fixed_fan(const OutCorner* o, int b, int* mark, int* twin) {
+  for (int i = 0; i < N; ++i) {
+    int& e = mark[o[i].to];
+    if (e >= b) return false;  // v -> w twice
+    e = b + i;
+  }
+  int place[N];  // twin[prev[o[i].corner]] is o[place[i]].corner
+  for (int i = 0; i < N; ++i) {
+    const int t = mark[o[i].from] - b;
+    if (t < 0) return false;  // u -> v has no opposite edge
+    twin[o[i].before] = o[t].corner;
+    place[i] = t;
+  }
+  // One fan: the walk is back at the first corner after N steps, and not before.
+  int i = 0;
+  bool early = false;
+  for (int step = 1; step < N; ++step) {
+    i = place[i];
+    early |= i == 0;
+  }
+  return !early && place[i] == 0;
+}
+
 /// Twins of every corner, or nothing when the soup is not a closed, oriented 2-manifold
 /// (an edge used twice in one direction or only once, a vertex with several fans).
 /// Also the first corner (in soup order) leaving each point (-1: none).
@@ -143,9 +180,7 @@ std::optional<Connectivity> connect(int num_points, const Soup& soup) {
   // of it: the point its edge goes to, and the corner before it (whose edge ends at the
   // vertex) with that corner's point. Read here in corner order, near each other, rather
   // than by chains of loads from the sorted corners in the fans below.
-  struct Out {
-    int corner, to, before, from;
-  };
+  using Out = OutCorner;
   std::vector<int>& out_begin = k.out_begin;
   out_begin.assign(num_points + 1, 0);
   const auto out = std::make_unique_for_overwrite<Out[]>(nc);
@@ -178,7 +213,24 @@ std::optional<Connectivity> connect(int num_points, const Soup& soup) {
       const int b = begin[v], n = begin[v + 1] - b;
       const Out* const o = order + b;
       first_out[v] = n > 0 ? o[0].corner : -1;
-      if (n == 0) return true;
+      switch (n) {  // the usual numbers of corners around a vertex: unrolled
+        case 0:
+          return true;
+        case 3:
+          return fixed_fan<3>(o, b, mark, twin);
+        case 4:
+          return fixed_fan<4>(o, b, mark, twin);
+        case 5:
+          return fixed_fan<5>(o, b, mark, twin);
+        case 6:
+          return fixed_fan<6>(o, b, mark, twin);
+        case 7:
+          return fixed_fan<7>(o, b, mark, twin);
+        case 8:
+          return fixed_fan<8>(o, b, mark, twin);
+        default:
+          break;
+      }
       for (int i = 0; i < n; ++i) {
         int& e = mark[o[i].to];
         if (e >= b) return false;  // v -> w twice
@@ -1033,7 +1085,7 @@ Mesh build_serial(const std::vector<V3<double>>& points, const Soup& soup, const
   // Plain pointers: the mesh's writes could alias the vectors' own pointers, which would
   // then be loaded again for each corner.
   const int *const vertex = soup.vertex.data(), *const twin = k.twin.data(),
-                   *const next = k.next.data(), *const begin = soup.begin.data();
+                   *const begin = soup.begin.data();
   int* const corner_halfedge = halfedge.data();
   const int nf = soup.size();
   // One pass, face by face (the corners in order): a face's halfedges are all known after
@@ -1042,26 +1094,39 @@ Mesh build_serial(const std::vector<V3<double>>& points, const Soup& soup, const
   const auto fill = [&](const auto& vh) {
     const auto he = [&](int c) { return Mesh::HalfedgeHandle(corner_halfedge[c]); };
     int edge = 0;
-    for (int f = 0; f < nf; ++f) {
-      const int b = begin[f], e = begin[f + 1];
-      for (int c = b; c < e; ++c) {
-        const int t = twin[c];
+    // Face f, of d corners from b (a corner's next is the one after it, or the first after
+    // the last). Triangles and quadrilaterals (nearly all faces) take a constant d: their
+    // loops are unrolled, as the exits of loops of three or four steps in irregular order
+    // were often mispredicted.
+    const auto add_face = [&](int f, int b, auto d) {
+      const auto after = [&](int i) { return i + 1 == d ? b : b + i + 1; };
+      for (int i = 0; i < d; ++i) {
+        const int c = b + i, t = twin[c];
         if (t < c) {
           corner_halfedge[c] = mesh.opposite_halfedge_handle(he(t)).idx();
         } else {
           corner_halfedge[c] = mesh.halfedge_handle(Mesh::EdgeHandle(edge++), 0).idx();
-          mesh.set_vertex_handle(he(c), vh(next[c]));
+          mesh.set_vertex_handle(he(c), vh(after(i)));
           mesh.set_vertex_handle(mesh.opposite_halfedge_handle(he(c)), vh(c));
         }
         // A vertex's halfedge is its last corner's (as when faces are added in order).
         mesh.set_halfedge_handle(vh(c), he(c));
       }
       const Mesh::FaceHandle fh(f);
-      for (int c = b; c < e; ++c) {
-        mesh.set_face_handle(he(c), fh);
-        mesh.set_next_halfedge_handle(he(c), he(next[c]));
+      for (int i = 0; i < d; ++i) {
+        mesh.set_face_handle(he(b + i), fh);
+        mesh.set_next_halfedge_handle(he(b + i), he(after(i)));
       }
-      mesh.set_halfedge_handle(fh, he(e - 1));  // as add_face: the cycle starts at vertex b
+      mesh.set_halfedge_handle(fh, he(b + d - 1));  // as add_face: the cycle starts at vertex b
+    };
+    for (int f = 0; f < nf; ++f) {
+      const int b = begin[f], d = begin[f + 1] - b;
+      if (d == 3)
+        add_face(f, b, std::integral_constant<int, 3>{});
+      else if (d == 4)
+        add_face(f, b, std::integral_constant<int, 4>{});
+      else
+        add_face(f, b, d);
     }
   };
   if (all_used)
