@@ -789,8 +789,8 @@ TEST_CASE("clean_mesh joins cones of any number of corners around the apex and i
         h = mesh.next_halfedge_handle(h);
       }
       CHECK(h == mesh.halfedge_handle(f));
-      CHECK(cycle == std::vector<int>(given.begin() + given_begin[s],
-                                      given.begin() + given_begin[s + 1]));
+      CHECK(cycle ==
+            std::vector<int>(given.begin() + given_begin[s], given.begin() + given_begin[s + 1]));
     }
   }
   for (int n = 3; n <= 5; ++n) {
