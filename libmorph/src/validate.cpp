@@ -7,6 +7,10 @@
 #include <morph/error.h>
 #include <morph/validate.h>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -472,9 +476,43 @@ struct PlaneHeight {
   }
 };
 
+// Two doubles operated on lane by lane (GCC and Clang vector extensions): each lane's
+// operations are the scalar ones, so each lane's value is the scalar value.
+using Pair = double __attribute__((vector_size(16)));
+
+// PlaneHeight of two points at once, one in each lane: the same values, in half the
+// operations (quad_passes() takes eight heights of each quadrilateral's neighbours).
+struct PlaneHeights {
+  Pair cx, cy, cz, nx, ny, nz;
+  explicit PlaneHeights(const PlaneHeight& h)
+      : cx{h.cx, h.cx}, cy{h.cy, h.cy}, cz{h.cz, h.cz}, nx{h.nx, h.nx}, ny{h.ny, h.ny},
+        nz{h.nz, h.nz} {}
+  Pair operator()(const Point& p, const Point& q) const {
+    const Pair x{p[0], q[0]}, y{p[1], q[1]}, z{p[2], q[2]};
+    return (x - cx) * nx + (y - cy) * ny + (z - cz) * nz;
+  }
+};
+
+// Whether both lanes of h are <= bound (false for a NaN, as the scalar test).
+inline bool both_at_most(Pair h, Pair bound) {
+#if defined(__SSE2__)
+  return _mm_movemask_pd(_mm_cmple_pd(h, bound)) == 3;
+#else
+  return h[0] <= bound[0] && h[1] <= bound[1];
+#endif
+}
+
+// |h| lane by lane (the sign bit cleared, as std::abs).
+inline Pair pair_abs(Pair h) {
+  using Bits = long long __attribute__((vector_size(16)));
+  constexpr Bits kMagnitude{0x7fffffffffffffffLL, 0x7fffffffffffffffLL};
+  return reinterpret_cast<Pair>(reinterpret_cast<Bits>(h) & kMagnitude);
+}
+
 // Six times the volume of the tetrahedron (o, a, b, c): FanVolumes::add_face()'s
-// dot(a - o, cross(b - o, c - o)), in OpenMesh's order of operations.
-inline double six_volume(const Point& o, const Point& a, const Point& b, const Point& c) {
+// dot(a - o, cross(b - o, c - o)), in OpenMesh's order of operations. Always inlined:
+// quad_plane() calls it twice a face, and GCC otherwise makes it a call.
+[[gnu::always_inline]] inline double six_volume(const Point& o, const Point& a, const Point& b, const Point& c) {
   const double u[3] = {a[0] - o[0], a[1] - o[1], a[2] - o[2]};
   const double v[3] = {b[0] - o[0], b[1] - o[1], b[2] - o[2]};
   const double w[3] = {c[0] - o[0], c[1] - o[1], c[2] - o[2]};
@@ -588,16 +626,17 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, const S
   return true;
 }
 
-// reflex_across() with the caller's height function, for quad_passes: a triangle's or a
-// quadrilateral's corners off the edge found without a loop. A quadrilateral g holds the edge
-// as to -> from (the opposite halfedge); its corners off the edge are the two after `from`.
-// When g repeats a vertex (so that these could differ from the loop's), g fails its own check
-// in nondegenerate(), and that failure is the verdict whatever the reflex flag says. Always
-// inlined: quad_passes() calls it four times a face, and GCC otherwise makes it a call.
-template <class Height>
+// reflex_across() with the caller's height functions, for quad_passes: a triangle's or a
+// quadrilateral's corners off the edge found without a loop (a quadrilateral's two in one pair).
+// A quadrilateral g holds the edge as to -> from (the opposite halfedge); its corners off the
+// edge are the two after `from`. When g repeats a vertex (so that these could differ from the
+// loop's), g fails its own check in nondegenerate(), and that failure is the verdict whatever
+// the reflex flag says. Always inlined: quad_passes() calls it four times a face, and GCC
+// otherwise makes it a call.
 [[gnu::always_inline]] inline bool reflex_across_small(const MeshView& m, const FaceCycles& cycles,
-                                                       const Height& height, int g, int from,
-                                                       int to, double tolerance) {
+                                                       const PlaneHeight& height,
+                                                       const PlaneHeights& heights, Pair tolerances,
+                                                       int g, int from, int to, double tolerance) {
   const int gb = cycles.begin[g];
   const int* corners = cycles.vertex + gb;
   const int n = cycles.begin[g + 1] - gb;
@@ -610,8 +649,8 @@ template <class Height>
   if (n == 4) {
     const int j = corners[0] == to ? 0 : corners[1] == to ? 1 : corners[2] == to ? 2 : 3;
     if (corners[(j + 1) & 3] == from && corners[j] == to)
-      return !(height(m.points[corners[(j + 2) & 3]]) <= tolerance) |
-             !(height(m.points[corners[(j + 3) & 3]]) <= tolerance);
+      return !both_at_most(
+          heights(m.points[corners[(j + 2) & 3]], m.points[corners[(j + 3) & 3]]), tolerances);
   }
   for (int k = 0; k < n; ++k) {
     const int v = corners[k];
@@ -677,18 +716,20 @@ bool quad_passes(const MeshView& m, const FaceCycles& cycles, int f, const Small
   // height(plane, p): dot(p - centroid, normal), summed in OpenMesh's order (a value, not a
   // closure over references: the calls below inline it).
   const PlaneHeight height{q.cx, q.cy, q.cz, q.nx, q.ny, q.nz};
-  if (non_planar_face < 0 &&
-      !(std::abs(height(p0)) <= tolerance && std::abs(height(p1)) <= tolerance &&
-        std::abs(height(p2)) <= tolerance && std::abs(height(p3)) <= tolerance))
+  const PlaneHeights heights(height);
+  const Pair tolerances{tolerance, tolerance};
+  if (non_planar_face < 0 && !(both_at_most(pair_abs(heights(p0, p1)), tolerances) &&
+                               both_at_most(pair_abs(heights(p2, p3)), tolerances)))
     non_planar_face = f;
   if (!convexity || any_reflex) return true;
   // Across the edge that ends at each corner (all four: the flag is the same, and the order
   // of the general path's early exit only decides where it stops).
   const int* across = cycles.across + b;
-  any_reflex = reflex_across_small(m, cycles, height, across[0], i3, i0, tolerance) |
-               reflex_across_small(m, cycles, height, across[1], i0, i1, tolerance) |
-               reflex_across_small(m, cycles, height, across[2], i1, i2, tolerance) |
-               reflex_across_small(m, cycles, height, across[3], i2, i3, tolerance);
+  any_reflex =
+      reflex_across_small(m, cycles, height, heights, tolerances, across[0], i3, i0, tolerance) |
+      reflex_across_small(m, cycles, height, heights, tolerances, across[1], i0, i1, tolerance) |
+      reflex_across_small(m, cycles, height, heights, tolerances, across[2], i1, i2, tolerance) |
+      reflex_across_small(m, cycles, height, heights, tolerances, across[3], i2, i3, tolerance);
   return true;
 }
 
