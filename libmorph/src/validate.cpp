@@ -485,7 +485,11 @@ using Pair = double __attribute__((vector_size(16)));
 struct PlaneHeights {
   Pair cx, cy, cz, nx, ny, nz;
   explicit PlaneHeights(const PlaneHeight& h)
-      : cx{h.cx, h.cx}, cy{h.cy, h.cy}, cz{h.cz, h.cz}, nx{h.nx, h.nx}, ny{h.ny, h.ny},
+      : cx{h.cx, h.cx},
+        cy{h.cy, h.cy},
+        cz{h.cz, h.cz},
+        nx{h.nx, h.nx},
+        ny{h.ny, h.ny},
         nz{h.nz, h.nz} {}
   Pair operator()(const Point& p, const Point& q) const {
     const Pair x{p[0], q[0]}, y{p[1], q[1]}, z{p[2], q[2]};
@@ -550,12 +554,12 @@ struct PlaneValues {
 };
 
 inline SmallPlane small_plane(const PlaneValues<double>& v, int degree) {
-  return {v.cx, v.cy, v.cz, v.nx, v.ny, v.nz, v.first, v.second, v.length2, v.magnitude, degree,
-          true};
+  return {v.cx,    v.cy,     v.cz,      v.nx,        v.ny,   v.nz,
+          v.first, v.second, v.length2, v.magnitude, degree, true};
 }
 inline SmallPlane small_plane(const PlaneValues<Pair>& v, int lane, int degree) {
-  return {v.cx[lane], v.cy[lane],     v.cz[lane],      v.nx[lane],        v.ny[lane], v.nz[lane],
-          v.first[lane], v.second[lane], v.length2[lane], v.magnitude[lane], degree,  true};
+  return {v.cx[lane],    v.cy[lane],     v.cz[lane],      v.nx[lane],        v.ny[lane], v.nz[lane],
+          v.first[lane], v.second[lane], v.length2[lane], v.magnitude[lane], degree,     true};
 }
 
 // A triangle's share of nondegenerate(), the usual case: the same operations in the same
@@ -604,12 +608,11 @@ SmallPlane triangle_plane(const MeshView& m, const int* ids, const Point& centre
 }
 
 // triangle_plane() of two triangles at once (a in lane 0, b in lane 1): the same values.
-void triangle_planes(const MeshView& m, const int* a, const int* b, const Point& centre,
-                     bool unit, SmallPlane& qa, SmallPlane& qb) {
+void triangle_planes(const MeshView& m, const int* a, const int* b, const Point& centre, bool unit,
+                     SmallPlane& qa, SmallPlane& qb) {
   const Point* const P = m.points;
-  const PlaneValues<Pair> v =
-      triangle_values(coords(P[a[0]], P[b[0]]), coords(P[a[1]], P[b[1]]),
-                      coords(P[a[2]], P[b[2]]), centre, unit);
+  const PlaneValues<Pair> v = triangle_values(coords(P[a[0]], P[b[0]]), coords(P[a[1]], P[b[1]]),
+                                              coords(P[a[2]], P[b[2]]), centre, unit);
   qa = small_plane(v, 0, 3);
   qb = small_plane(v, 1, 3);
 }
@@ -706,8 +709,8 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, const S
   if (n == 4) {
     const int j = corners[0] == to ? 0 : corners[1] == to ? 1 : corners[2] == to ? 2 : 3;
     if (corners[(j + 1) & 3] == from && corners[j] == to)
-      return !both_at_most(
-          heights(m.points[corners[(j + 2) & 3]], m.points[corners[(j + 3) & 3]]), tolerances);
+      return !both_at_most(heights(m.points[corners[(j + 2) & 3]], m.points[corners[(j + 3) & 3]]),
+                           tolerances);
   }
   for (int k = 0; k < n; ++k) {
     const int v = corners[k];
@@ -876,8 +879,8 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
       for (int f = block; f < block_end; ++f) {
         SmallPlane& q = planes[f - block];
         const int n = geometry.cycles.degree(f);
-        const bool two = f + 1 < block_end && geometry.cycles.degree(f + 1) == n &&
-                         m.live_face(f + 1);
+        const bool two =
+            f + 1 < block_end && geometry.cycles.degree(f + 1) == n && m.live_face(f + 1);
         if (n == 3 && m.live_face(f)) {
           if (two) {
             triangle_planes(m, geometry.cycles.corners(f), geometry.cycles.corners(f + 1), centre,
@@ -888,8 +891,8 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
           }
         } else if (n == 4 && m.live_face(f)) {
           if (two) {
-            quad_planes(m, geometry.cycles.corners(f), geometry.cycles.corners(f + 1), centre,
-                        unit, q, planes[f + 1 - block]);
+            quad_planes(m, geometry.cycles.corners(f), geometry.cycles.corners(f + 1), centre, unit,
+                        q, planes[f + 1 - block]);
             ++f;
           } else {
             q = quad_plane(m, geometry.cycles.corners(f), centre, unit);
