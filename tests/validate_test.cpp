@@ -604,3 +604,46 @@ TEST_CASE("validate: quadrilaterals keep the general path's verdicts and message
     check_quad_variants(mesh_of(cube_points(), reversed(kCubeQuads)), "inverted");
   }
 }
+
+// nondegenerate() plans two triangles, or two quadrilaterals, at once where they follow each
+// other (validate.cpp, triangle_planes and quad_planes: one face in each lane), and one at a
+// time otherwise. Either way each face's values must be its own: the verdicts and messages are
+// those of the general path on every sequence of triangles and quadrilaterals, at the tolerance
+// where the verdict turns, and with two corners at one position in either lane of a pair.
+TEST_CASE("validate: faces planed two at a time keep the general path's verdicts") {
+  SUBCASE("every mix of the cube's quads and their halves, in two alignments of the pairs") {
+    for (int split = 0; split < 64; ++split)
+      for (const int shift : {0, 1}) {
+        std::vector<std::vector<int>> faces;
+        for (int q = 0; q < 6; ++q) {
+          const std::vector<int>& quad = kCubeQuads[q];
+          if (split >> q & 1) {
+            faces.push_back({quad[0], quad[1], quad[2]});
+            faces.push_back({quad[0], quad[2], quad[3]});
+          } else {
+            faces.push_back(quad);
+          }
+        }
+        std::rotate(faces.begin(), faces.begin() + shift, faces.end());
+        const std::string what =
+            "split " + std::to_string(split) + ", shifted by " + std::to_string(shift);
+        const Mesh cube = jittered(mesh_of(cube_points(), faces), 1e-11, split + 1);
+        check_at_boundary(cube, what);
+        // A reflex corner: the edges around it bind in faces of both kinds.
+        std::vector<Point> dented = cube_points();
+        dented[7] = Point(0.9, 0.9, 0.9);
+        CHECK(check_quad_variants(mesh_of(dented, faces), what + ", dented") != "");
+      }
+  }
+  SUBCASE("two corners at one position, in the first or the second face of a pair") {
+    for (int v = 0; v < 8; ++v)
+      for (int w = 0; w < 8; ++w) {
+        if (v == w) continue;
+        std::vector<Point> pinched = cube_points();
+        pinched[v] = pinched[w];
+        const std::string what = "vertex " + std::to_string(v) + " on " + std::to_string(w);
+        CHECK(check_quad_variants(mesh_of(pinched, kCubeQuads), what + ", quads") != "");
+        CHECK(check_quad_variants(mesh_of(pinched, cube_triangles()), what + ", triangles") != "");
+      }
+  }
+}

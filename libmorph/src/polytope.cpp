@@ -823,9 +823,8 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   // Corner c is a halfedge of its face: leaving the corner's vertex when as given; when
   // reversed, entering it (the facet runs against the halfedges). What the walks know of
   // mesh edge h / 2 (OpenMesh stores the two halfedges of edge e as 2e and 2e + 1), in its
-  // two low bits: 0 unwalked, 1 + (h & 1) once the corner of halfedge h has met it, 3 once
-  // both have; above them, the polytope edge once it has one (below 2^30: at most nh / 2).
-  constexpr unsigned kWalked = 3;
+  // two low bits: bit h & 1 set once the corner of halfedge h has met it; above them, the
+  // polytope edge once it has one (below 2^30: at most nh / 2).
   std::vector<unsigned> edge_state(nh / 2, 0);
   p.face_begin.resize(nf + 1);
   p.corner_vertex.resize(nh);
@@ -867,26 +866,27 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
     int previous = h0;  // the halfedge walked before h (as given: it ends at the corner)
     int h = start;
     do {
-      // Each halfedge once (its edge not walked, or walked by the other halfedge only):
-      // with the count below, every halfedge is some face's.
+      // Each halfedge once (its bit not set): with the count below, every halfedge is some
+      // face's. Each corner sets its halfedge's bit, so at most nh corners are written (c < nh
+      // while some halfedge is unwalked).
       unsigned& state = edge_state[h >> 1];
-      const unsigned walked = state & 3u;
-      if (c == nh || walked == kWalked || (walked != 0 && walked - 1 == (h & 1u)) ||
-          arrays.face(h) != f || (reversed ? arrays.next(h) : arrays.prev(h)) != previous)
+      const unsigned bit = 1u << (h & 1);
+      if ((state & bit) != 0 || arrays.face(h) != f ||
+          (reversed ? arrays.next(h) : arrays.prev(h)) != previous)
         throw error("internal error: a mesh face is not a closed cycle");
       const int vertex = reversed ? arrays.to(h) : from;
       corner_vertex[c] = vertex;
       some_slot[vertex] = previous;
       int edge;
-      if (walked == 0) {  // the edge's first corner
+      if (state == 0) {  // the edge's first corner
         edge = e++;
-        state = (static_cast<unsigned>(edge) << 2) | (1u + (h & 1u));
+        state = (static_cast<unsigned>(edge) << 2) | bit;
         edges[edge].from = vertex;
         edges[edge].left = f;
         mesh_edge[edge] = h >> 1;
       } else {
         edge = static_cast<int>(state >> 2);
-        state |= kWalked;
+        state |= bit;
         edges[edge].to = vertex;
         edges[edge].right = f;
       }

@@ -7,6 +7,10 @@
 #include <morph/error.h>
 #include <morph/validate.h>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -472,51 +476,145 @@ struct PlaneHeight {
   }
 };
 
+// Two doubles operated on lane by lane (GCC and Clang vector extensions): each lane's
+// operations are the scalar ones, so each lane's value is the scalar value.
+using Pair = double __attribute__((vector_size(16)));
+
+// PlaneHeight of two points at once, one in each lane: the same values, in half the
+// operations (quad_passes() takes eight heights of each quadrilateral's neighbours).
+struct PlaneHeights {
+  Pair cx, cy, cz, nx, ny, nz;
+  explicit PlaneHeights(const PlaneHeight& h)
+      : cx{h.cx, h.cx},
+        cy{h.cy, h.cy},
+        cz{h.cz, h.cz},
+        nx{h.nx, h.nx},
+        ny{h.ny, h.ny},
+        nz{h.nz, h.nz} {}
+  Pair operator()(const Point& p, const Point& q) const {
+    const Pair x{p[0], q[0]}, y{p[1], q[1]}, z{p[2], q[2]};
+    return (x - cx) * nx + (y - cy) * ny + (z - cz) * nz;
+  }
+};
+
+// Whether both lanes of h are <= bound (false for a NaN, as the scalar test).
+inline bool both_at_most(Pair h, Pair bound) {
+#if defined(__SSE2__)
+  return _mm_movemask_pd(_mm_cmple_pd(h, bound)) == 3;
+#else
+  return h[0] <= bound[0] && h[1] <= bound[1];
+#endif
+}
+
+// |h| lane by lane (the sign bit cleared, as std::abs).
+inline Pair pair_abs(Pair h) {
+  using Bits = long long __attribute__((vector_size(16)));
+  constexpr Bits kMagnitude{0x7fffffffffffffffLL, 0x7fffffffffffffffLL};
+  return reinterpret_cast<Pair>(reinterpret_cast<Bits>(h) & kMagnitude);
+}
+
+// A corner's coordinates: doubles, or Pairs holding one face's corner in each lane.
+template <class T>
+struct Coords {
+  T x, y, z;
+};
+
+inline Coords<double> coords(const Point& p) { return {p[0], p[1], p[2]}; }
+inline Coords<Pair> coords(const Point& p, const Point& q) {
+  return {Pair{p[0], q[0]}, Pair{p[1], q[1]}, Pair{p[2], q[2]}};
+}
+
+inline double abs_of(double x) { return std::abs(x); }
+inline Pair abs_of(Pair x) { return pair_abs(x); }
+
+// norm1() lane by lane.
+template <class T>
+inline T norm1_of(T x, T y, T z) {
+  return abs_of(x) + abs_of(y) + abs_of(z);
+}
+
 // Six times the volume of the tetrahedron (o, a, b, c): FanVolumes::add_face()'s
-// dot(a - o, cross(b - o, c - o)), in OpenMesh's order of operations.
-inline double six_volume(const Point& o, const Point& a, const Point& b, const Point& c) {
-  const double u[3] = {a[0] - o[0], a[1] - o[1], a[2] - o[2]};
-  const double v[3] = {b[0] - o[0], b[1] - o[1], b[2] - o[2]};
-  const double w[3] = {c[0] - o[0], c[1] - o[1], c[2] - o[2]};
+// dot(a - o, cross(b - o, c - o)), in OpenMesh's order of operations. Always inlined:
+// quad_plane() calls it twice a face, and GCC otherwise makes it a call.
+template <class T>
+[[gnu::always_inline]] inline T six_volume(const Point& o, const Coords<T>& a, const Coords<T>& b,
+                                           const Coords<T>& c) {
+  const T u[3] = {a.x - o[0], a.y - o[1], a.z - o[2]};
+  const T v[3] = {b.x - o[0], b.y - o[1], b.z - o[2]};
+  const T w[3] = {c.x - o[0], c.y - o[1], c.z - o[2]};
   return (u[0] * (v[1] * w[2] - v[2] * w[1]) + u[1] * (v[2] * w[0] - v[0] * w[2])) +
          u[2] * (v[0] * w[1] - v[1] * w[0]);
+}
+
+// SmallPlane's values, of one face (doubles) or of two (Pairs, one face in each lane: each
+// lane's operations are those of one face, so its values are that face's).
+template <class T>
+struct PlaneValues {
+  T cx, cy, cz, nx, ny, nz, first, second, length2, magnitude;
+};
+
+inline SmallPlane small_plane(const PlaneValues<double>& v, int degree) {
+  return {v.cx,    v.cy,     v.cz,      v.nx,        v.ny,   v.nz,
+          v.first, v.second, v.length2, v.magnitude, degree, true};
+}
+inline SmallPlane small_plane(const PlaneValues<Pair>& v, int lane, int degree) {
+  return {v.cx[lane],    v.cy[lane],     v.cz[lane],      v.nx[lane],        v.ny[lane], v.nz[lane],
+          v.first[lane], v.second[lane], v.length2[lane], v.magnitude[lane], degree,     true};
 }
 
 // A triangle's share of nondegenerate(), the usual case: the same operations in the same
 // order as newell_plane(), height(), FanVolumes::add_face() and reflex_across(), unrolled
 // into one place (the general path's loops and calls cost more than its arithmetic), so
 // every value and verdict is the general path's. In two parts (see SmallPlane):
-// triangle_plane(), then triangle_passes(), which returns false, having changed nothing,
-// when the triangle fails one of the checks that reject a mesh: the general path then
-// names the problem.
-SmallPlane triangle_plane(const MeshView& m, const int* ids, const Point& centre, bool unit) {
-  const int i0 = ids[0], i1 = ids[1], i2 = ids[2];
-  // A repeated vertex or position needs no test of its own here: with two equal corners,
-  // two of the cross products below are opposites and the third is zero (a x a), so the
-  // normal is exactly zero (in round-to-nearest; within a few ulps of D^2 in any rounding
-  // mode, far below kZeroAreaRatio D^2) and the zero-area test rejects the triangle.
-  const Point &p0 = m.points[i0], &p1 = m.points[i1], &p2 = m.points[i2];
-  // In plain doubles, straight-line: OpenMesh's vector operations, one component at a time.
-  const double cx = (((0.0 + p0[0]) + p1[0]) + p2[0]) * (1.0 / 3);
-  const double cy = (((0.0 + p0[1]) + p1[1]) + p2[1]) * (1.0 / 3);
-  const double cz = (((0.0 + p0[2]) + p1[2]) + p2[2]) * (1.0 / 3);
+// triangle_plane() (or triangle_planes(), two at once), then triangle_passes(), which returns
+// false, having changed nothing, when the triangle fails one of the checks that reject a mesh:
+// the general path then names the problem.
+// A repeated vertex or position needs no test of its own here: with two equal corners, two of
+// the cross products below are opposites and the third is zero (a x a), so the normal is
+// exactly zero (in round-to-nearest; within a few ulps of D^2 in any rounding mode, far below
+// kZeroAreaRatio D^2) and the zero-area test rejects the triangle.
+template <class T>
+[[gnu::always_inline]] inline PlaneValues<T> triangle_values(const Coords<T>& p0,
+                                                             const Coords<T>& p1,
+                                                             const Coords<T>& p2,
+                                                             const Point& centre, bool unit) {
+  // Straight-line: OpenMesh's vector operations, one component at a time.
+  const T cx = (((0.0 + p0.x) + p1.x) + p2.x) * (1.0 / 3);
+  const T cy = (((0.0 + p0.y) + p1.y) + p2.y) * (1.0 / 3);
+  const T cz = (((0.0 + p0.z) + p1.z) + p2.z) * (1.0 / 3);
   // The corners relative to the centroid.
-  const double ax = p0[0] - cx, ay = p0[1] - cy, az = p0[2] - cz;
-  const double bx = p1[0] - cx, by = p1[1] - cy, bz = p1[2] - cz;
-  const double qx = p2[0] - cx, qy = p2[1] - cy, qz = p2[2] - cz;
+  const T ax = p0.x - cx, ay = p0.y - cy, az = p0.z - cz;
+  const T bx = p1.x - cx, by = p1.y - cy, bz = p1.z - cz;
+  const T qx = p2.x - cx, qy = p2.y - cy, qz = p2.z - cz;
   // cross(u, v) component i: u[j] v[l] - u[l] v[j] with (j, l) = (i + 1, i + 2) mod 3,
   // summed over the edges a-b, b-q, q-a from zero.
-  const double nx = ((0.0 + (ay * bz - az * by)) + (by * qz - bz * qy)) + (qy * az - qz * ay);
-  const double ny = ((0.0 + (az * bx - ax * bz)) + (bz * qx - bx * qz)) + (qz * ax - qx * az);
-  const double nz = ((0.0 + (ax * by - ay * bx)) + (bx * qy - by * qx)) + (qx * ay - qy * ax);
-  double magnitude = 0;
+  const T nx = ((0.0 + (ay * bz - az * by)) + (by * qz - bz * qy)) + (qy * az - qz * ay);
+  const T ny = ((0.0 + (az * bx - ax * bz)) + (bz * qx - bx * qz)) + (qz * ax - qx * az);
+  const T nz = ((0.0 + (ax * by - ay * bx)) + (bx * qy - by * qx)) + (qx * ay - qy * ax);
+  T magnitude{};
   if (unit) {
-    const double la = norm1(ax, ay, az), lb = norm1(bx, by, bz), lq = norm1(qx, qy, qz);
+    const T la = norm1_of(ax, ay, az), lb = norm1_of(bx, by, bz), lq = norm1_of(qx, qy, qz);
     magnitude = (la * lb + lb * lq) + lq * la;
   }
   // FanVolumes::add_face(): the one tetrahedron (q, a, b) of the fan from the last corner.
-  const double volume = six_volume(centre, p2, p0, p1), length2 = (nx * nx + ny * ny) + nz * nz;
-  return {cx, cy, cz, nx, ny, nz, volume, 0, length2, magnitude, 3, true};
+  const T volume = six_volume(centre, p2, p0, p1), length2 = (nx * nx + ny * ny) + nz * nz;
+  return {cx, cy, cz, nx, ny, nz, volume, T{}, length2, magnitude};
+}
+
+SmallPlane triangle_plane(const MeshView& m, const int* ids, const Point& centre, bool unit) {
+  const Point* const P = m.points;
+  return small_plane(
+      triangle_values(coords(P[ids[0]]), coords(P[ids[1]]), coords(P[ids[2]]), centre, unit), 3);
+}
+
+// triangle_plane() of two triangles at once (a in lane 0, b in lane 1): the same values.
+void triangle_planes(const MeshView& m, const int* a, const int* b, const Point& centre, bool unit,
+                     SmallPlane& qa, SmallPlane& qb) {
+  const Point* const P = m.points;
+  const PlaneValues<Pair> v = triangle_values(coords(P[a[0]], P[b[0]]), coords(P[a[1]], P[b[1]]),
+                                              coords(P[a[2]], P[b[2]]), centre, unit);
+  qa = small_plane(v, 0, 3);
+  qb = small_plane(v, 1, 3);
 }
 
 // kProve: `proven`, when set (the caller has every face's unit normal in `unit`), is left set
@@ -588,16 +686,17 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, const S
   return true;
 }
 
-// reflex_across() with the caller's height function, for quad_passes: a triangle's or a
-// quadrilateral's corners off the edge found without a loop. A quadrilateral g holds the edge
-// as to -> from (the opposite halfedge); its corners off the edge are the two after `from`.
-// When g repeats a vertex (so that these could differ from the loop's), g fails its own check
-// in nondegenerate(), and that failure is the verdict whatever the reflex flag says. Always
-// inlined: quad_passes() calls it four times a face, and GCC otherwise makes it a call.
-template <class Height>
+// reflex_across() with the caller's height functions, for quad_passes: a triangle's or a
+// quadrilateral's corners off the edge found without a loop (a quadrilateral's two in one pair).
+// A quadrilateral g holds the edge as to -> from (the opposite halfedge); its corners off the
+// edge are the two after `from`. When g repeats a vertex (so that these could differ from the
+// loop's), g fails its own check in nondegenerate(), and that failure is the verdict whatever
+// the reflex flag says. Always inlined: quad_passes() calls it four times a face, and GCC
+// otherwise makes it a call.
 [[gnu::always_inline]] inline bool reflex_across_small(const MeshView& m, const FaceCycles& cycles,
-                                                       const Height& height, int g, int from,
-                                                       int to, double tolerance) {
+                                                       const PlaneHeight& height,
+                                                       const PlaneHeights& heights, Pair tolerances,
+                                                       int g, int from, int to, double tolerance) {
   const int gb = cycles.begin[g];
   const int* corners = cycles.vertex + gb;
   const int n = cycles.begin[g + 1] - gb;
@@ -610,8 +709,8 @@ template <class Height>
   if (n == 4) {
     const int j = corners[0] == to ? 0 : corners[1] == to ? 1 : corners[2] == to ? 2 : 3;
     if (corners[(j + 1) & 3] == from && corners[j] == to)
-      return !(height(m.points[corners[(j + 2) & 3]]) <= tolerance) |
-             !(height(m.points[corners[(j + 3) & 3]]) <= tolerance);
+      return !both_at_most(heights(m.points[corners[(j + 2) & 3]], m.points[corners[(j + 3) & 3]]),
+                           tolerances);
   }
   for (int k = 0; k < n; ++k) {
     const int v = corners[k];
@@ -624,42 +723,75 @@ template <class Height>
 // A quadrilateral's share of nondegenerate() (UV spheres and boxes are made of them), as
 // triangle_passes: the same operations in the same order as newell_plane(), height(),
 // FanVolumes::add_face() and reflex_across(), written out, so every value and verdict is
-// the general path's. Returns false, having changed nothing, when the quadrilateral repeats
-// a vertex or a position or has zero area: the general path then names the problem (a
-// repeated vertex does not zero a quadrilateral's normal, so both are tested here).
-SmallPlane quad_plane(const MeshView& m, const int* ids, const Point& centre, bool unit) {
-  SmallPlane q;
-  q.ok = false;
+// the general path's. quad_plane() (or quad_planes(), two at once) returns ok false when the
+// quadrilateral repeats a vertex or a position, and quad_passes() returns false, having changed
+// nothing, then or when it has zero area: the general path then names the problem (a repeated
+// vertex does not zero a quadrilateral's normal, so both are tested here).
+bool quad_corners_distinct(const MeshView& m, const int* ids) {
   const int i0 = ids[0], i1 = ids[1], i2 = ids[2], i3 = ids[3];
-  if (i0 == i1 || i0 == i2 || i0 == i3 || i1 == i2 || i1 == i3 || i2 == i3) return q;
+  if (i0 == i1 || i0 == i2 || i0 == i3 || i1 == i2 || i1 == i3 || i2 == i3) return false;
   const Point &p0 = m.points[i0], &p1 = m.points[i1], &p2 = m.points[i2], &p3 = m.points[i3];
-  if (p0 == p1 || p0 == p2 || p0 == p3 || p1 == p2 || p1 == p3 || p2 == p3) return q;
+  return !(p0 == p1 || p0 == p2 || p0 == p3 || p1 == p2 || p1 == p3 || p2 == p3);
+}
+
+template <class T>
+[[gnu::always_inline]] inline PlaneValues<T> quad_values(const Coords<T>& p0, const Coords<T>& p1,
+                                                         const Coords<T>& p2, const Coords<T>& p3,
+                                                         const Point& centre, bool unit) {
   // newell_plane(): the centroid summed from zero and scaled by 1.0 / 4 (exactly 0.25).
-  const double cx = ((((0.0 + p0[0]) + p1[0]) + p2[0]) + p3[0]) * (1.0 / 4);
-  const double cy = ((((0.0 + p0[1]) + p1[1]) + p2[1]) + p3[1]) * (1.0 / 4);
-  const double cz = ((((0.0 + p0[2]) + p1[2]) + p2[2]) + p3[2]) * (1.0 / 4);
+  const T cx = ((((0.0 + p0.x) + p1.x) + p2.x) + p3.x) * (1.0 / 4);
+  const T cy = ((((0.0 + p0.y) + p1.y) + p2.y) + p3.y) * (1.0 / 4);
+  const T cz = ((((0.0 + p0.z) + p1.z) + p2.z) + p3.z) * (1.0 / 4);
   // The corners relative to the centroid, and cross(u, v) summed over the edges a-b, b-q,
   // q-r, r-a from zero (component i: u[j] v[l] - u[l] v[j], (j, l) = (i + 1, i + 2) mod 3).
-  const double ax = p0[0] - cx, ay = p0[1] - cy, az = p0[2] - cz;
-  const double bx = p1[0] - cx, by = p1[1] - cy, bz = p1[2] - cz;
-  const double qx = p2[0] - cx, qy = p2[1] - cy, qz = p2[2] - cz;
-  const double rx = p3[0] - cx, ry = p3[1] - cy, rz = p3[2] - cz;
-  const double nx = (((0.0 + (ay * bz - az * by)) + (by * qz - bz * qy)) + (qy * rz - qz * ry)) +
-                    (ry * az - rz * ay);
-  const double ny = (((0.0 + (az * bx - ax * bz)) + (bz * qx - bx * qz)) + (qz * rx - qx * rz)) +
-                    (rz * ax - rx * az);
-  const double nz = (((0.0 + (ax * by - ay * bx)) + (bx * qy - by * qx)) + (qx * ry - qy * rx)) +
-                    (rx * ay - ry * ax);
-  double magnitude = 0;
+  const T ax = p0.x - cx, ay = p0.y - cy, az = p0.z - cz;
+  const T bx = p1.x - cx, by = p1.y - cy, bz = p1.z - cz;
+  const T qx = p2.x - cx, qy = p2.y - cy, qz = p2.z - cz;
+  const T rx = p3.x - cx, ry = p3.y - cy, rz = p3.z - cz;
+  const T nx = (((0.0 + (ay * bz - az * by)) + (by * qz - bz * qy)) + (qy * rz - qz * ry)) +
+               (ry * az - rz * ay);
+  const T ny = (((0.0 + (az * bx - ax * bz)) + (bz * qx - bx * qz)) + (qz * rx - qx * rz)) +
+               (rz * ax - rx * az);
+  const T nz = (((0.0 + (ax * by - ay * bx)) + (bx * qy - by * qx)) + (qx * ry - qy * rx)) +
+               (rx * ay - ry * ax);
+  T magnitude{};
   if (unit) {
-    const double la = norm1(ax, ay, az), lb = norm1(bx, by, bz), lq = norm1(qx, qy, qz),
-                 lr = norm1(rx, ry, rz);
+    const T la = norm1_of(ax, ay, az), lb = norm1_of(bx, by, bz), lq = norm1_of(qx, qy, qz),
+            lr = norm1_of(rx, ry, rz);
     magnitude = ((la * lb + lb * lq) + lq * lr) + lr * la;
   }
   // FanVolumes::add_face(): the fan from the last corner, tetrahedra (r, a, b), (r, b, q).
-  const double first = six_volume(centre, p3, p0, p1), second = six_volume(centre, p3, p1, p2);
-  const double length2 = (nx * nx + ny * ny) + nz * nz;
-  return {cx, cy, cz, nx, ny, nz, first, second, length2, magnitude, 4, true};
+  const T first = six_volume(centre, p3, p0, p1), second = six_volume(centre, p3, p1, p2);
+  const T length2 = (nx * nx + ny * ny) + nz * nz;
+  return {cx, cy, cz, nx, ny, nz, first, second, length2, magnitude};
+}
+
+SmallPlane quad_plane(const MeshView& m, const int* ids, const Point& centre, bool unit) {
+  if (!quad_corners_distinct(m, ids)) {
+    SmallPlane q;
+    q.ok = false;
+    return q;
+  }
+  const Point* const P = m.points;
+  return small_plane(quad_values(coords(P[ids[0]]), coords(P[ids[1]]), coords(P[ids[2]]),
+                                 coords(P[ids[3]]), centre, unit),
+                     4);
+}
+
+// quad_plane() of two quadrilaterals at once (a in lane 0, b in lane 1): the same values.
+void quad_planes(const MeshView& m, const int* a, const int* b, const Point& centre, bool unit,
+                 SmallPlane& qa, SmallPlane& qb) {
+  if (!quad_corners_distinct(m, a) || !quad_corners_distinct(m, b)) {
+    qa = quad_plane(m, a, centre, unit);
+    qb = quad_plane(m, b, centre, unit);
+    return;
+  }
+  const Point* const P = m.points;
+  const PlaneValues<Pair> v =
+      quad_values(coords(P[a[0]], P[b[0]]), coords(P[a[1]], P[b[1]]), coords(P[a[2]], P[b[2]]),
+                  coords(P[a[3]], P[b[3]]), centre, unit);
+  qa = small_plane(v, 0, 4);
+  qb = small_plane(v, 1, 4);
 }
 
 bool quad_passes(const MeshView& m, const FaceCycles& cycles, int f, const SmallPlane& q,
@@ -677,18 +809,20 @@ bool quad_passes(const MeshView& m, const FaceCycles& cycles, int f, const Small
   // height(plane, p): dot(p - centroid, normal), summed in OpenMesh's order (a value, not a
   // closure over references: the calls below inline it).
   const PlaneHeight height{q.cx, q.cy, q.cz, q.nx, q.ny, q.nz};
-  if (non_planar_face < 0 &&
-      !(std::abs(height(p0)) <= tolerance && std::abs(height(p1)) <= tolerance &&
-        std::abs(height(p2)) <= tolerance && std::abs(height(p3)) <= tolerance))
+  const PlaneHeights heights(height);
+  const Pair tolerances{tolerance, tolerance};
+  if (non_planar_face < 0 && !(both_at_most(pair_abs(heights(p0, p1)), tolerances) &&
+                               both_at_most(pair_abs(heights(p2, p3)), tolerances)))
     non_planar_face = f;
   if (!convexity || any_reflex) return true;
   // Across the edge that ends at each corner (all four: the flag is the same, and the order
   // of the general path's early exit only decides where it stops).
   const int* across = cycles.across + b;
-  any_reflex = reflex_across_small(m, cycles, height, across[0], i3, i0, tolerance) |
-               reflex_across_small(m, cycles, height, across[1], i0, i1, tolerance) |
-               reflex_across_small(m, cycles, height, across[2], i1, i2, tolerance) |
-               reflex_across_small(m, cycles, height, across[3], i2, i3, tolerance);
+  any_reflex =
+      reflex_across_small(m, cycles, height, heights, tolerances, across[0], i3, i0, tolerance) |
+      reflex_across_small(m, cycles, height, heights, tolerances, across[1], i0, i1, tolerance) |
+      reflex_across_small(m, cycles, height, heights, tolerances, across[2], i1, i2, tolerance) |
+      reflex_across_small(m, cycles, height, heights, tolerances, across[3], i2, i3, tolerance);
   return true;
 }
 
@@ -741,15 +875,31 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
   for (int block = 0; block < m.n_faces; block += kPlaneBlock) {
     const int block_end = std::min(m.n_faces, block + kPlaneBlock);
     if (shortcuts) {
+      // Two faces at once where two triangles or two quadrilaterals follow each other.
       for (int f = block; f < block_end; ++f) {
         SmallPlane& q = planes[f - block];
         const int n = geometry.cycles.degree(f);
-        if (n == 3 && m.live_face(f))
-          q = triangle_plane(m, geometry.cycles.corners(f), centre, unit);
-        else if (n == 4 && m.live_face(f))
-          q = quad_plane(m, geometry.cycles.corners(f), centre, unit);
-        else
+        const bool two =
+            f + 1 < block_end && geometry.cycles.degree(f + 1) == n && m.live_face(f + 1);
+        if (n == 3 && m.live_face(f)) {
+          if (two) {
+            triangle_planes(m, geometry.cycles.corners(f), geometry.cycles.corners(f + 1), centre,
+                            unit, q, planes[f + 1 - block]);
+            ++f;
+          } else {
+            q = triangle_plane(m, geometry.cycles.corners(f), centre, unit);
+          }
+        } else if (n == 4 && m.live_face(f)) {
+          if (two) {
+            quad_planes(m, geometry.cycles.corners(f), geometry.cycles.corners(f + 1), centre, unit,
+                        q, planes[f + 1 - block]);
+            ++f;
+          } else {
+            q = quad_plane(m, geometry.cycles.corners(f), centre, unit);
+          }
+        } else {
           q.ok = false;
+        }
       }
       for (int f = block; f < block_end; ++f)
         plane_root(planes[f - block], zero_area, unit ? unit + f : nullptr, unit_complete);
