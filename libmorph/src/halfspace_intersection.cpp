@@ -244,9 +244,9 @@ struct ExactCoordinates {
 /// (intervals, then double-double) cannot decide, or for a polytope chained further.
 struct HVertex {
   std::array<int, 3> planes;
+  int known = -1;  // the known point it is (KnownPoints), if any
   V3<Interval> Xi;
-  Interval Wi;
-  V3<Interval> xi;  // Xi / Wi
+  Interval Wi;  // (X / W as Xi / Wi where needed: quotient, not kept)
   // The exact coordinates, once known (X not null): a known point's are KnownPoints' own
   // (not copied: most are never read), another's are made on first need into `made`. Off
   // the vertex itself (four Mpzf are 350 bytes), which the flips and the check create,
@@ -254,7 +254,6 @@ struct HVertex {
   const V3<ExactN>* X = nullptr;
   const ExactN* W = nullptr;
   std::unique_ptr<ExactCoordinates> made;
-  int known = -1;  // the known point it is (KnownPoints), if any
   // X and W times some positive factor in double-double, within ex and ew of the exact
   // ones times that factor (make_precise); only when `precise`.
   V3<DD> px{};
@@ -267,7 +266,7 @@ struct HVertex {
   // hi + lo in one rounded addition (make_precise).
   bool exact_dd = false;
   bool doubles = false;  // a known point X / 1 with X exactly doubles: its rounding is X
-  // Xi, Wi and xi are set (`intervals`), or only the double filter's X and W with their
+  // Xi and Wi are set (`intervals`), or only the double filter's X and W with their
   // magnitudes (`fast`, made from fast planes: kMeetError), the intervals then made where
   // that filter cannot decide (make_intervals), most vertices never needing them. Those
   // doubles are kept in Xi and Wi (X and W as inf, their magnitudes as sup, unchecked): no
@@ -340,17 +339,22 @@ void meet(const V3<T>& na, const T& da, const V3<T>& nb, const T& db, const V3<T
   meet_of_crosses(na, da, db, dc, cross(nb, nc), cross(nc, na), cross(na, nb), X, W);
 }
 
-/// The interval meet of a vertex's three planes, X / W and X, W (needs a RoundingGuard).
+/// The interval meet of a vertex's three planes, X and W (needs a RoundingGuard).
 void interval_meet(const std::vector<Plane>& planes, const std::array<int, 3>& abc,
-                   V3<Interval>& Xi, Interval& Wi, V3<Interval>& xi) {
+                   V3<Interval>& Xi, Interval& Wi) {
   const Plane &a = planes[abc[0]], &b = planes[abc[1]], &c = planes[abc[2]];
   meet(a.ni, a.di, b.ni, b.di, c.ni, c.di, Xi, Wi);
-  xi = {Xi.x / Wi, Xi.y / Wi, Xi.z / Wi};
+}
+/// X / W of interval X and W (needs a RoundingGuard). Computed where it is read, rarely
+/// (intervals of a vertex are mostly made for its sides), rather than kept in each vertex,
+/// which the flips and the checks create, move and reset by the thousand.
+V3<Interval> quotient(const V3<Interval>& Xi, const Interval& Wi) {
+  return {Xi.x / Wi, Xi.y / Wi, Xi.z / Wi};
 }
 /// Gives v its intervals, when it has only doubles (needs a RoundingGuard).
 void make_intervals(const std::vector<Plane>& planes, HVertex& v) {
   if (v.intervals) return;
-  interval_meet(planes, v.planes, v.Xi, v.Wi, v.xi);
+  interval_meet(planes, v.planes, v.Xi, v.Wi);
   v.intervals = true;
   v.fast = false;  // (its doubles were in Xi and Wi)
 }
@@ -383,13 +387,13 @@ HVertex vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& ab
                 magnitude_cross(b.na, c.na), magnitude_cross(c.na, a.na),
                 magnitude_cross(a.na, b.na), v);
   } else {
-    interval_meet(planes, abc, v.Xi, v.Wi, v.xi);
+    interval_meet(planes, abc, v.Xi, v.Wi);
     v.intervals = true;
   }
   return v;
 }
 
-/// An enclosure of X / W (needs a RoundingGuard): the vertex's xi, or, for a vertex with
+/// An enclosure of X / W (needs a RoundingGuard): the vertex's Xi / Wi, or, for a vertex with
 /// only doubles, X and W widened by kMeetError of their magnitudes when W > 0 is certain
 /// (fewer operations than the interval meet), else the interval meet.
 V3<Interval> enclosure_of(const std::vector<Plane>& planes, const HVertex& v);
@@ -401,12 +405,12 @@ bool w_positive(const HVertex& v) {
 }
 
 V3<Interval> enclosure_of(const std::vector<Plane>& planes, const HVertex& v) {
-  if (v.intervals) return v.xi;
+  if (v.intervals) return quotient(v.Xi, v.Wi);
   if (!w_positive(v)) {
-    V3<Interval> Xi, xi;
+    V3<Interval> Xi;
     Interval Wi;
-    interval_meet(planes, v.planes, Xi, Wi, xi);
-    return xi;
+    interval_meet(planes, v.planes, Xi, Wi);
+    return quotient(Xi, Wi);
   }
   const auto widened = [](double x, double m) {
     const double e = kMeetError * m + kDoubleFloor;  // (rounded up: the guard's mode)
@@ -422,7 +426,6 @@ void set_known(const KnownPoints& known, int k, HVertex& v) {
   v.known = k;
   v.Xi = known.Xi[k];
   v.Wi = known.Wi[k];
-  v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
   v.intervals = true;
   v.fast = false;
   v.X = &known.X[k];
@@ -794,9 +797,9 @@ int double_compare(const Plane& p, const HVertex& u, const HVertex& v) {
 /// here (not kept: v may be shared between threads).
 int interval_side(const std::vector<Plane>& planes, const Plane& p, const HVertex& v) {
   if (v.intervals) return interval_sign(dot(p.ni, v.Xi) - p.di * v.Wi);
-  V3<Interval> Xi, xi;
+  V3<Interval> Xi;
   Interval Wi;
-  interval_meet(planes, v.planes, Xi, Wi, xi);
+  interval_meet(planes, v.planes, Xi, Wi);
   return interval_sign(dot(p.ni, Xi) - p.di * Wi);
 }
 
@@ -874,11 +877,14 @@ int compare_filter(const std::vector<Plane>& planes, const PrecisePlanes& precis
   };
   const auto interval_sign_of = [&] {
     // (Intervals made here where a vertex has none: not kept, the vertices are shared.)
-    V3<Interval> Xi, ui, vi;
-    Interval Wi;
-    if (!u.intervals) interval_meet(planes, u.planes, Xi, Wi, ui);
-    if (!v.intervals) interval_meet(planes, v.planes, Xi, Wi, vi);
-    return interval_sign(dot(p.ni, u.intervals ? u.xi : ui) - dot(p.ni, v.intervals ? v.xi : vi));
+    const auto enclosure = [&](const HVertex& x) {
+      if (x.intervals) return quotient(x.Xi, x.Wi);
+      V3<Interval> Xi;
+      Interval Wi;
+      interval_meet(planes, x.planes, Xi, Wi);
+      return quotient(Xi, Wi);
+    };
+    return interval_sign(dot(p.ni, enclosure(u)) - dot(p.ni, enclosure(v)));
   };
   if (stage && precise.made(i)) {
     const int t = precise_sign();
@@ -1056,8 +1062,10 @@ bool clockwise(const std::vector<int>& cyc, const std::vector<HVertex>& vertex,
   const int n = static_cast<int>(cyc.size());
   {
     RoundingGuard guard;
+    std::vector<V3<Interval>> x(n);
+    for (int i = 0; i < n; ++i) x[i] = quotient(vertex[cyc[i]].Xi, vertex[cyc[i]].Wi);
     const V3<Interval> nw =
-        newell_normal<Interval>(n, [&](int i) -> const V3<Interval>& { return vertex[cyc[i]].xi; });
+        newell_normal<Interval>(n, [&](int i) -> const V3<Interval>& { return x[i]; });
     const int s = interval_sign(dot(nw, to_interval_n(normal)));
     if (s != 2) return s < 0;
   }
@@ -2010,7 +2018,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
         // (Any estimate serves: round_quotient only starts from it.)
         const double q = v.intervals ? 0 : coordinate(v.Xd(), i) / v.Wd();
         const Interval estimate =
-            v.intervals ? coordinate(v.xi, i) : Interval(std::isfinite(q) ? q : 0.0);
+            v.intervals ? coordinate(v.Xi, i) / v.Wi : Interval(std::isfinite(q) ? q : 0.0);
         rounded[i] = round_quotient(coordinate(*e.X, i), *e.W, estimate);
       }
       rp.points[r] = {rounded[0], rounded[1], rounded[2]};
@@ -2115,7 +2123,6 @@ class IncrementalHull {
       } else {
         v.Xi = tri.Xi;
         v.Wi = tri.Wi;
-        v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
         v.intervals = true;
         if (tri.precise >= 0) {
           const HVertex& q = precise_vertex_[tri.precise];
@@ -2632,8 +2639,7 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
     scratch.has_cross[at] = 1;
     return at;
   };
-  // Triangle t's vertex, as vertex_of(planes, abc, known) computes it but for xi, which
-  // the flips' tests do not use: made for the final triangles only.
+  // Triangle t's vertex, as vertex_of(planes, abc, known) computes it.
   const auto compute_vertex = [&](int t) {
     ready[t] = 1;
     const auto [i, j, l] = triangle[t];
@@ -2657,7 +2663,7 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
       v.intervals = true;
       v.fast = false;
     }
-    take_known(known, v);  // (a known point's xi is set)
+    take_known(known, v);
   };
   // Triangle t's vertex (computed when first tested); false when t is not positively
   // oriented.
@@ -2722,8 +2728,6 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
       out_far[3 * t + m] = diagonal(x, y) ? diagonal_side(x, y) : 2;
     }
     if (!ready[t]) compute_vertex(static_cast<int>(t));
-    HVertex& v = vertex[t];
-    if (v.known < 0 && v.intervals) v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
     out_has[t] = 1;
   }
   return true;
