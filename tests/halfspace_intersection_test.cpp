@@ -1310,6 +1310,57 @@ TEST_CASE("halfspace_intersection: sums rounded by the precise stage are the exa
   CHECK(near_decided == 0);      // its bound is far wider than 2^-60 ulp
 }
 
+// The precise rounding tests the candidate X.hi / W.hi moved by its residual, with that
+// candidate's residual updated from the first one's (round_precise): quotients X / W with
+// odd W (never a double-double's exact quotient), X / W a random double moved by d ulps
+// (d from 0 to 1, and just off the midpoint), at scales up to 2^+-300 and across powers of
+// two. Every decision is the exact rounding, and every quotient further than 2^-30 ulp from
+// a midpoint is decided (the updated residual's bound is tight enough).
+TEST_CASE("halfspace_intersection: the precise rounding's corrected candidate rounds exactly") {
+  CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+  std::mt19937_64 random(13);
+  std::uniform_real_distribution<double> unit(1.0, 2.0);
+  int far = 0, far_decided = 0, decided = 0;
+  const double offsets[] = {0.0, 0.1, 0.3, 0.49, 0.5 - 0x1p-20, 0.5 + 0x1p-20, 0.51, 0.7, 0.9};
+  for (int trial = 0; trial < 60; ++trial) {
+    const int e = trial % 3 == 0 ? 0 : trial % 3 == 1 ? 300 : -300;
+    // Every fifth a power of two, where the gaps on either side differ.
+    const double x = std::ldexp(trial % 5 == 0 ? (trial % 2 ? 1.0 : -1.0) : unit(random), e);
+    const double ulp = std::nextafter(std::abs(x), HUGE_VAL) - std::abs(x);
+    for (const double d : offsets) {
+      for (const double sign : {1.0, -1.0}) {
+        const ExactN y = ExactN(x) + ExactN(sign * d * ulp);  // (exact: few bits)
+        const double want = round_to_nearest(Exact(y));
+        for (const double w : {3.0, 7.0, 105.0, 0x1p-200 * 11}) {
+          const ExactN W(w), X = y * W;
+          for (const int scale : {0, 90, -90}) {
+            double ex, ew, got;
+            const DD Xd = scaled_dd(X, scale, 0.0, ex), Wd = scaled_dd(W, scale, 0.0, ew);
+            if (!std::isfinite(ex) || !std::isfinite(ew)) continue;
+            const bool ok = round_precise_sum(Xd, ex, Wd, ew, 0.0, got);
+            // Distance to the nearest midpoint, in ulps of the smaller gap.
+            const double from_mid = std::abs(0.5 - std::abs(std::fmod(d, 1.0)));
+            if (from_mid > 0x1p-30 && std::abs(x) != std::ldexp(1.0, e)) {
+              ++far;
+              far_decided += ok;
+            }
+            if (!ok) continue;
+            ++decided;
+            CAPTURE(trial);
+            CAPTURE(d);
+            CAPTURE(w);
+            CAPTURE(scale);
+            CHECK(same_double(got, want));
+          }
+        }
+      }
+    }
+  }
+  CHECK(far > 1000);
+  CHECK(far_decided == far);
+  CHECK(decided >= far);
+}
+
 // Whole openings by both routes: random polytopes and elements of several sizes, operands
 // scaled by 2^+-200, far from the origin, and an element 2^-40 times A's size (its sums lie
 // within rounding of A's vertices).
