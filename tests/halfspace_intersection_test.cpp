@@ -374,6 +374,52 @@ TEST_CASE("halfspace_intersection: known points and an expected result give the 
   CHECK(difference(wrong, checked(cut)) == "");
 }
 
+// A guess whose triangles do not close into a surface (a vertex's polygon left out, one
+// given twice, one turned round) is given up when its triangles are paired across their
+// edges (each edge a -> b with a < b searched once, setting its reverse too): the hull
+// computes the result, the same.
+TEST_CASE("halfspace_intersection: a guess that is not a closed surface is given up") {
+  const std::vector<HalfSpace> hs = planes_through_apex(12);
+  const MaybePolytope plain = checked(hs);
+  REQUIRE(plain.polytope);
+  const Polytope& p = *plain.polytope;
+  const int nv = p.num_vertices();
+  REQUIRE(nv >= 4);
+  const auto fan = [&](int v) {
+    std::vector<int> f;
+    for (int j = p.fan_begin[v]; j < p.fan_begin[v + 1]; ++j)
+      f.push_back(p.face_source[p.fan_face[j]]);
+    return f;
+  };
+  const auto guess_of = [&](const std::vector<std::vector<int>>& fans) {
+    ExpectedVertices e;
+    e.begin.push_back(0);
+    for (const auto& f : fans) {
+      e.facets.insert(e.facets.end(), f.begin(), f.end());
+      e.begin.push_back(static_cast<int>(e.facets.size()));
+    }
+    return e;
+  };
+  std::vector<std::vector<int>> fans;
+  for (int v = 0; v < nv; ++v) fans.push_back(fan(v));
+  const MaybePolytope whole = intersect_halfspaces(hs, {0, 0, 0}, {}, {}, guess_of(fans));
+  CHECK(whole.route == HullRoute::expected);
+  CHECK(difference(whole, plain) == "");
+  std::vector<std::vector<std::vector<int>>> broken;
+  broken.emplace_back(fans.begin(), fans.end() - 1);  // open
+  broken.push_back(fans);
+  broken.back().push_back(fans[0]);  // edges used twice
+  broken.push_back(fans);
+  std::reverse(broken.back()[1].begin(), broken.back()[1].end());  // turned round
+  for (std::size_t k = 0; k < broken.size(); ++k) {
+    CAPTURE(k);
+    const MaybePolytope got = intersect_halfspaces(hs, {0, 0, 0}, {}, {}, guess_of(broken[k]));
+    CHECK(got.route != HullRoute::expected);
+    CHECK(got.route != HullRoute::repaired);
+    CHECK(difference(got, plain) == "");
+  }
+}
+
 // A closing erodes S = A (+) B by B: the guess (A, with S's translated facets) is taken
 // when A's facets are planar, rejected for the UV sphere's nearly planar quads, and either
 // way the result is the one erode_polytope's hull gives (which knows nothing of the sum).

@@ -84,11 +84,15 @@ struct Plane {
   // Its normal's or offset's double-double copy, when it has one (denominator 1).
   const HalfSpace* source = nullptr;
   // The double filter's copy (see kMeetError): each component within one ulp of the exact
-  // one (plus the gap to zero of a subnormal), and their absolute values. `fast` when all
-  // are at most kFastRange (no overflow; underflow then stays below kDoubleFloor).
-  V3<double> nd{}, na{};
-  double dd = 0, da = 0;
+  // one (plus the gap to zero of a subnormal); na() and da() their absolute values (not
+  // kept: the planes are read in scattered order, and a smaller one costs fewer cache
+  // misses). `fast` when all are at most kFastRange (no overflow; underflow then stays
+  // below kDoubleFloor).
+  V3<double> nd{};
+  double dd = 0;
   bool fast = false;
+  V3<double> na() const { return {std::abs(nd.x), std::abs(nd.y), std::abs(nd.z)}; }
+  double da() const { return std::abs(dd); }
 };
 
 // The double filter. A vertex's X and W (Cramer's rule, meet_of_crosses) are evaluated in
@@ -127,10 +131,9 @@ void set_doubles(Plane& p) {
           pick(p.ni.y, nd ? &h->normal_dd[1] : nullptr),
           pick(p.ni.z, nd ? &h->normal_dd[2] : nullptr)};
   p.dd = pick(p.di, od ? &h->offset_dd : nullptr);
-  p.na = {std::abs(p.nd.x), std::abs(p.nd.y), std::abs(p.nd.z)};
-  p.da = std::abs(p.dd);
-  p.fast = p.na.x <= kFastRange && p.na.y <= kFastRange && p.na.z <= kFastRange &&
-           p.da <= kFastRange;  // (false for NaN)
+  const V3<double> na = p.na();
+  p.fast = na.x <= kFastRange && na.y <= kFastRange && na.z <= kFastRange &&
+           p.da() <= kFastRange;  // (false for NaN)
 }
 
 /// The magnitude of a cross product: |a| x |b| with its subtraction an addition.
@@ -367,7 +370,7 @@ void double_meet(const Plane& a, const Plane& b, const Plane& c, const V3<double
   V3<double> X, MX;
   double W, MW;
   meet_of_crosses(a.nd, a.dd, b.dd, c.dd, bc, ca, ab, X, W);
-  meet_of_crosses(a.na, a.da, b.da, c.da, mbc, mca, mab, MX, MW);  // (all additions)
+  meet_of_crosses(a.na(), a.da(), b.da(), c.da(), mbc, mca, mab, MX, MW);  // (all additions)
   using Unchecked = Interval::no_check_t;
   v.Xi = {Interval(X.x, MX.x, Unchecked()), Interval(X.y, MX.y, Unchecked()),
           Interval(X.z, MX.z, Unchecked())};
@@ -384,8 +387,8 @@ HVertex vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& ab
   const Plane &a = planes[abc[0]], &b = planes[abc[1]], &c = planes[abc[2]];
   if (a.fast && b.fast && c.fast) {
     double_meet(a, b, c, cross(b.nd, c.nd), cross(c.nd, a.nd), cross(a.nd, b.nd),
-                magnitude_cross(b.na, c.na), magnitude_cross(c.na, a.na),
-                magnitude_cross(a.na, b.na), v);
+                magnitude_cross(b.na(), c.na()), magnitude_cross(c.na(), a.na()),
+                magnitude_cross(a.na(), b.na()), v);
   } else {
     interval_meet(planes, abc, v.Xi, v.Wi);
     v.intervals = true;
@@ -775,7 +778,9 @@ int double_side(const Plane& p, const HVertex& v) {
   const V3<double> X = v.Xd(), M = v.MX();
   const double value = p.nd.x * X.x + p.nd.y * X.y + p.nd.z * X.z - p.dd * v.Wd();
   const double bound =
-      kSideError * (p.na.x * M.x + p.na.y * M.y + p.na.z * M.z + p.da * v.MW()) + kDoubleFloor;
+      kSideError * (std::abs(p.nd.x) * M.x + std::abs(p.nd.y) * M.y + std::abs(p.nd.z) * M.z +
+                    p.da() * v.MW()) +
+      kDoubleFloor;
   if (value > bound) return 1;
   if (value < -bound) return -1;
   return 2;
@@ -785,7 +790,8 @@ int double_side(const Plane& p, const HVertex& v) {
 int double_compare(const Plane& p, const HVertex& u, const HVertex& v) {
   if (!p.fast || !u.fast || !v.fast) return 2;
   const double nu = dot(p.nd, u.Xd()), nv = dot(p.nd, v.Xd());
-  const double mu = dot(p.na, u.MX()), mv = dot(p.na, v.MX());
+  const V3<double> na = p.na();
+  const double mu = dot(na, u.MX()), mv = dot(na, v.MX());
   const double value = nu * v.Wd() - nv * u.Wd();
   const double bound = kCompareError * (mu * v.MW() + mv * u.MW()) + kDoubleFloor;
   if (value > bound) return 1;
@@ -2018,7 +2024,16 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     const auto coordinate = [](const auto& p, int i) -> const auto& {
       return i == 0 ? p.x : i == 1 ? p.y : p.z;
     };
+    // The vertices are read in the output's order, scattered over the array: the records a
+    // few ahead are fetched while this one rounds (its flags and precise coordinates span
+    // two cache lines).
+    constexpr int kAhead = 6;
     for (int r = begin; r < end; ++r) {
+      if (r + kAhead < end) {
+        const HVertex& ahead = vertex[order[r + kAhead]];
+        __builtin_prefetch(&ahead.px);
+        __builtin_prefetch(&ahead.ew);
+      }
       const HVertex& v = vertex[order[r]];
       double rounded[3];
       const double inverse = v.precise ? 1 / v.pw.hi : 0;
@@ -2654,7 +2669,7 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
     } else {
       const Plane &a = planes[p[i]], &b = planes[p[j]];
       scratch.dcross[at] = cross(a.nd, b.nd);
-      scratch.mcross[at] = magnitude_cross(a.na, b.na);
+      scratch.mcross[at] = magnitude_cross(a.na(), b.na());
     }
     scratch.has_cross[at] = 1;
     return at;
@@ -2791,12 +2806,23 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const PrecisePlan
   if (!ok) return {};
   // Directed edges 3 t + k (corner k to k + 1 of triangle t) listed by their first plane
   // (a counting sort), each with its second plane: each edge's reverse is the one edge back
-  // among the few leaving its second plane.
+  // among the few leaving its second plane. Only edges a -> b with a < b search (the search's
+  // variable length cost a mispredicted exit each); each sets its reverse's `across` too.
+  // Every edge has exactly one reverse (a closed surface, each edge used once) iff each
+  // search finds exactly one, every edge b -> a with b > a is reached, and there are as many
+  // of those as of the searching ones (then the searches pair them one to one).
   const auto next_corner = [](int k) { return k == 2 ? 0 : k + 1; };
   std::vector<int> out_begin(planes.size() + 1, 0), out_edge(3 * static_cast<std::size_t>(nt)),
       out_head(out_edge.size());
+  std::ptrdiff_t balance = 0;  // edges a -> b with a < b, less those with a > b
   for (const auto& c : s.corner)
-    for (int a : c) ++out_begin[a + 1];
+    for (int k = 0; k < 3; ++k) {
+      ++out_begin[c[k] + 1];
+      const int a = c[k], b = c[next_corner(k)];
+      if (a == b) return {};
+      balance += a < b ? 1 : -1;
+    }
+  if (balance != 0) return {};
   std::partial_sum(out_begin.begin(), out_begin.end(), out_begin.begin());
   {
     std::vector<int> next(out_begin.begin(), out_begin.end() - 1);
@@ -2807,19 +2833,27 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const PrecisePlan
         out_head[j] = s.corner[t][next_corner(k)];
       }
   }
-  s.across.resize(nt);
+  s.across.assign(nt, {-1, -1, -1});
   parallel_chunks(nt, 1024, [&](int begin, int end) {
     for (int t = begin; t < end && ok; ++t)
       for (int k = 0; k < 3; ++k) {
         const int a = s.corner[t][k], b = s.corner[t][next_corner(k)];
+        if (a > b) continue;  // set by its reverse's search
         int back = -1, found = 0;
         for (int j = out_begin[b]; j < out_begin[b + 1]; ++j)
           if (out_head[j] == a) back = out_edge[j], ++found;
-        if (found != 1) ok = false;  // an open surface, or an edge used twice
+        if (found != 1) {
+          ok = false;  // an open surface, or an edge used twice
+          break;
+        }
         s.across[t][k] = back / 3;
+        // (Atomic: two searches reach one edge where the surface is not closed.)
+        std::atomic_ref<int>(s.across[back / 3][back % 3]).store(t, std::memory_order_relaxed);
       }
   });
   if (!ok) return {};
+  for (const auto& u : s.across)
+    if (u[0] < 0 || u[1] < 0 || u[2] < 0) return {};
   return s;
 }
 
