@@ -374,6 +374,52 @@ TEST_CASE("halfspace_intersection: known points and an expected result give the 
   CHECK(difference(wrong, checked(cut)) == "");
 }
 
+// A guess whose triangles do not close into a surface (a vertex's polygon left out, one
+// given twice, one turned round) is given up when its triangles are paired across their
+// edges (each edge a -> b with a < b searched once, setting its reverse too): the hull
+// computes the result, the same.
+TEST_CASE("halfspace_intersection: a guess that is not a closed surface is given up") {
+  const std::vector<HalfSpace> hs = planes_through_apex(12);
+  const MaybePolytope plain = checked(hs);
+  REQUIRE(plain.polytope);
+  const Polytope& p = *plain.polytope;
+  const int nv = p.num_vertices();
+  REQUIRE(nv >= 4);
+  const auto fan = [&](int v) {
+    std::vector<int> f;
+    for (int j = p.fan_begin[v]; j < p.fan_begin[v + 1]; ++j)
+      f.push_back(p.face_source[p.fan_face[j]]);
+    return f;
+  };
+  const auto guess_of = [&](const std::vector<std::vector<int>>& fans) {
+    ExpectedVertices e;
+    e.begin.push_back(0);
+    for (const auto& f : fans) {
+      e.facets.insert(e.facets.end(), f.begin(), f.end());
+      e.begin.push_back(static_cast<int>(e.facets.size()));
+    }
+    return e;
+  };
+  std::vector<std::vector<int>> fans;
+  for (int v = 0; v < nv; ++v) fans.push_back(fan(v));
+  const MaybePolytope whole = intersect_halfspaces(hs, {0, 0, 0}, {}, {}, guess_of(fans));
+  CHECK(whole.route == HullRoute::expected);
+  CHECK(difference(whole, plain) == "");
+  std::vector<std::vector<std::vector<int>>> broken;
+  broken.emplace_back(fans.begin(), fans.end() - 1);  // open
+  broken.push_back(fans);
+  broken.back().push_back(fans[0]);  // edges used twice
+  broken.push_back(fans);
+  std::reverse(broken.back()[1].begin(), broken.back()[1].end());  // turned round
+  for (std::size_t k = 0; k < broken.size(); ++k) {
+    CAPTURE(k);
+    const MaybePolytope got = intersect_halfspaces(hs, {0, 0, 0}, {}, {}, guess_of(broken[k]));
+    CHECK(got.route != HullRoute::expected);
+    CHECK(got.route != HullRoute::repaired);
+    CHECK(difference(got, plain) == "");
+  }
+}
+
 // A closing erodes S = A (+) B by B: the guess (A, with S's translated facets) is taken
 // when A's facets are planar, rejected for the UV sphere's nearly planar quads, and either
 // way the result is the one erode_polytope's hull gives (which knows nothing of the sum).
@@ -1308,6 +1354,57 @@ TEST_CASE("halfspace_intersection: sums rounded by the precise stage are the exa
                   << " within 2^-60 ulp of a midpoint");
   CHECK(decidable > total / 8);  // the stage does its work where it can
   CHECK(near_decided == 0);      // its bound is far wider than 2^-60 ulp
+}
+
+// The precise rounding tests the candidate X.hi / W.hi moved by its residual, with that
+// candidate's residual updated from the first one's (round_precise): quotients X / W with
+// odd W (never a double-double's exact quotient), X / W a random double moved by d ulps
+// (d from 0 to 1, and just off the midpoint), at scales up to 2^+-300 and across powers of
+// two. Every decision is the exact rounding, and every quotient further than 2^-30 ulp from
+// a midpoint is decided (the updated residual's bound is tight enough).
+TEST_CASE("halfspace_intersection: the precise rounding's corrected candidate rounds exactly") {
+  CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+  std::mt19937_64 random(13);
+  std::uniform_real_distribution<double> unit(1.0, 2.0);
+  int far = 0, far_decided = 0, decided = 0;
+  const double offsets[] = {0.0, 0.1, 0.3, 0.49, 0.5 - 0x1p-20, 0.5 + 0x1p-20, 0.51, 0.7, 0.9};
+  for (int trial = 0; trial < 60; ++trial) {
+    const int e = trial % 3 == 0 ? 0 : trial % 3 == 1 ? 300 : -300;
+    // Every fifth a power of two, where the gaps on either side differ.
+    const double x = std::ldexp(trial % 5 == 0 ? (trial % 2 ? 1.0 : -1.0) : unit(random), e);
+    const double ulp = std::nextafter(std::abs(x), HUGE_VAL) - std::abs(x);
+    for (const double d : offsets) {
+      for (const double sign : {1.0, -1.0}) {
+        const ExactN y = ExactN(x) + ExactN(sign * d * ulp);  // (exact: few bits)
+        const double want = round_to_nearest(Exact(y));
+        for (const double w : {3.0, 7.0, 105.0, 0x1p-200 * 11}) {
+          const ExactN W(w), X = y * W;
+          for (const int scale : {0, 90, -90}) {
+            double ex, ew, got;
+            const DD Xd = scaled_dd(X, scale, 0.0, ex), Wd = scaled_dd(W, scale, 0.0, ew);
+            if (!std::isfinite(ex) || !std::isfinite(ew)) continue;
+            const bool ok = round_precise_sum(Xd, ex, Wd, ew, 0.0, got);
+            // Distance to the nearest midpoint, in ulps of the smaller gap.
+            const double from_mid = std::abs(0.5 - std::abs(std::fmod(d, 1.0)));
+            if (from_mid > 0x1p-30 && std::abs(x) != std::ldexp(1.0, e)) {
+              ++far;
+              far_decided += ok;
+            }
+            if (!ok) continue;
+            ++decided;
+            CAPTURE(trial);
+            CAPTURE(d);
+            CAPTURE(w);
+            CAPTURE(scale);
+            CHECK(same_double(got, want));
+          }
+        }
+      }
+    }
+  }
+  CHECK(far > 1000);
+  CHECK(far_decided == far);
+  CHECK(decided >= far);
 }
 
 // Whole openings by both routes: random polytopes and elements of several sizes, operands

@@ -84,11 +84,15 @@ struct Plane {
   // Its normal's or offset's double-double copy, when it has one (denominator 1).
   const HalfSpace* source = nullptr;
   // The double filter's copy (see kMeetError): each component within one ulp of the exact
-  // one (plus the gap to zero of a subnormal), and their absolute values. `fast` when all
-  // are at most kFastRange (no overflow; underflow then stays below kDoubleFloor).
-  V3<double> nd{}, na{};
-  double dd = 0, da = 0;
+  // one (plus the gap to zero of a subnormal); na() and da() their absolute values (not
+  // kept: the planes are read in scattered order, and a smaller one costs fewer cache
+  // misses). `fast` when all are at most kFastRange (no overflow; underflow then stays
+  // below kDoubleFloor).
+  V3<double> nd{};
+  double dd = 0;
   bool fast = false;
+  V3<double> na() const { return {std::abs(nd.x), std::abs(nd.y), std::abs(nd.z)}; }
+  double da() const { return std::abs(dd); }
 };
 
 // The double filter. A vertex's X and W (Cramer's rule, meet_of_crosses) are evaluated in
@@ -127,10 +131,9 @@ void set_doubles(Plane& p) {
           pick(p.ni.y, nd ? &h->normal_dd[1] : nullptr),
           pick(p.ni.z, nd ? &h->normal_dd[2] : nullptr)};
   p.dd = pick(p.di, od ? &h->offset_dd : nullptr);
-  p.na = {std::abs(p.nd.x), std::abs(p.nd.y), std::abs(p.nd.z)};
-  p.da = std::abs(p.dd);
-  p.fast = p.na.x <= kFastRange && p.na.y <= kFastRange && p.na.z <= kFastRange &&
-           p.da <= kFastRange;  // (false for NaN)
+  const V3<double> na = p.na();
+  p.fast = na.x <= kFastRange && na.y <= kFastRange && na.z <= kFastRange &&
+           p.da() <= kFastRange;  // (false for NaN)
 }
 
 /// The magnitude of a cross product: |a| x |b| with its subtraction an addition.
@@ -244,9 +247,9 @@ struct ExactCoordinates {
 /// (intervals, then double-double) cannot decide, or for a polytope chained further.
 struct HVertex {
   std::array<int, 3> planes;
+  int known = -1;  // the known point it is (KnownPoints), if any
   V3<Interval> Xi;
-  Interval Wi;
-  V3<Interval> xi;  // Xi / Wi
+  Interval Wi;  // (X / W as Xi / Wi where needed: quotient, not kept)
   // The exact coordinates, once known (X not null): a known point's are KnownPoints' own
   // (not copied: most are never read), another's are made on first need into `made`. Off
   // the vertex itself (four Mpzf are 350 bytes), which the flips and the check create,
@@ -254,7 +257,6 @@ struct HVertex {
   const V3<ExactN>* X = nullptr;
   const ExactN* W = nullptr;
   std::unique_ptr<ExactCoordinates> made;
-  int known = -1;  // the known point it is (KnownPoints), if any
   // X and W times some positive factor in double-double, within ex and ew of the exact
   // ones times that factor (make_precise); only when `precise`.
   V3<DD> px{};
@@ -267,7 +269,7 @@ struct HVertex {
   // hi + lo in one rounded addition (make_precise).
   bool exact_dd = false;
   bool doubles = false;  // a known point X / 1 with X exactly doubles: its rounding is X
-  // Xi, Wi and xi are set (`intervals`), or only the double filter's X and W with their
+  // Xi and Wi are set (`intervals`), or only the double filter's X and W with their
   // magnitudes (`fast`, made from fast planes: kMeetError), the intervals then made where
   // that filter cannot decide (make_intervals), most vertices never needing them. Those
   // doubles are kept in Xi and Wi (X and W as inf, their magnitudes as sup, unchecked): no
@@ -340,17 +342,22 @@ void meet(const V3<T>& na, const T& da, const V3<T>& nb, const T& db, const V3<T
   meet_of_crosses(na, da, db, dc, cross(nb, nc), cross(nc, na), cross(na, nb), X, W);
 }
 
-/// The interval meet of a vertex's three planes, X / W and X, W (needs a RoundingGuard).
+/// The interval meet of a vertex's three planes, X and W (needs a RoundingGuard).
 void interval_meet(const std::vector<Plane>& planes, const std::array<int, 3>& abc,
-                   V3<Interval>& Xi, Interval& Wi, V3<Interval>& xi) {
+                   V3<Interval>& Xi, Interval& Wi) {
   const Plane &a = planes[abc[0]], &b = planes[abc[1]], &c = planes[abc[2]];
   meet(a.ni, a.di, b.ni, b.di, c.ni, c.di, Xi, Wi);
-  xi = {Xi.x / Wi, Xi.y / Wi, Xi.z / Wi};
+}
+/// X / W of interval X and W (needs a RoundingGuard). Computed where it is read, rarely
+/// (intervals of a vertex are mostly made for its sides), rather than kept in each vertex,
+/// which the flips and the checks create, move and reset by the thousand.
+V3<Interval> quotient(const V3<Interval>& Xi, const Interval& Wi) {
+  return {Xi.x / Wi, Xi.y / Wi, Xi.z / Wi};
 }
 /// Gives v its intervals, when it has only doubles (needs a RoundingGuard).
 void make_intervals(const std::vector<Plane>& planes, HVertex& v) {
   if (v.intervals) return;
-  interval_meet(planes, v.planes, v.Xi, v.Wi, v.xi);
+  interval_meet(planes, v.planes, v.Xi, v.Wi);
   v.intervals = true;
   v.fast = false;  // (its doubles were in Xi and Wi)
 }
@@ -363,7 +370,7 @@ void double_meet(const Plane& a, const Plane& b, const Plane& c, const V3<double
   V3<double> X, MX;
   double W, MW;
   meet_of_crosses(a.nd, a.dd, b.dd, c.dd, bc, ca, ab, X, W);
-  meet_of_crosses(a.na, a.da, b.da, c.da, mbc, mca, mab, MX, MW);  // (all additions)
+  meet_of_crosses(a.na(), a.da(), b.da(), c.da(), mbc, mca, mab, MX, MW);  // (all additions)
   using Unchecked = Interval::no_check_t;
   v.Xi = {Interval(X.x, MX.x, Unchecked()), Interval(X.y, MX.y, Unchecked()),
           Interval(X.z, MX.z, Unchecked())};
@@ -380,16 +387,16 @@ HVertex vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& ab
   const Plane &a = planes[abc[0]], &b = planes[abc[1]], &c = planes[abc[2]];
   if (a.fast && b.fast && c.fast) {
     double_meet(a, b, c, cross(b.nd, c.nd), cross(c.nd, a.nd), cross(a.nd, b.nd),
-                magnitude_cross(b.na, c.na), magnitude_cross(c.na, a.na),
-                magnitude_cross(a.na, b.na), v);
+                magnitude_cross(b.na(), c.na()), magnitude_cross(c.na(), a.na()),
+                magnitude_cross(a.na(), b.na()), v);
   } else {
-    interval_meet(planes, abc, v.Xi, v.Wi, v.xi);
+    interval_meet(planes, abc, v.Xi, v.Wi);
     v.intervals = true;
   }
   return v;
 }
 
-/// An enclosure of X / W (needs a RoundingGuard): the vertex's xi, or, for a vertex with
+/// An enclosure of X / W (needs a RoundingGuard): the vertex's Xi / Wi, or, for a vertex with
 /// only doubles, X and W widened by kMeetError of their magnitudes when W > 0 is certain
 /// (fewer operations than the interval meet), else the interval meet.
 V3<Interval> enclosure_of(const std::vector<Plane>& planes, const HVertex& v);
@@ -401,12 +408,12 @@ bool w_positive(const HVertex& v) {
 }
 
 V3<Interval> enclosure_of(const std::vector<Plane>& planes, const HVertex& v) {
-  if (v.intervals) return v.xi;
+  if (v.intervals) return quotient(v.Xi, v.Wi);
   if (!w_positive(v)) {
-    V3<Interval> Xi, xi;
+    V3<Interval> Xi;
     Interval Wi;
-    interval_meet(planes, v.planes, Xi, Wi, xi);
-    return xi;
+    interval_meet(planes, v.planes, Xi, Wi);
+    return quotient(Xi, Wi);
   }
   const auto widened = [](double x, double m) {
     const double e = kMeetError * m + kDoubleFloor;  // (rounded up: the guard's mode)
@@ -422,7 +429,6 @@ void set_known(const KnownPoints& known, int k, HVertex& v) {
   v.known = k;
   v.Xi = known.Xi[k];
   v.Wi = known.Wi[k];
-  v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
   v.intervals = true;
   v.fast = false;
   v.X = &known.X[k];
@@ -772,7 +778,9 @@ int double_side(const Plane& p, const HVertex& v) {
   const V3<double> X = v.Xd(), M = v.MX();
   const double value = p.nd.x * X.x + p.nd.y * X.y + p.nd.z * X.z - p.dd * v.Wd();
   const double bound =
-      kSideError * (p.na.x * M.x + p.na.y * M.y + p.na.z * M.z + p.da * v.MW()) + kDoubleFloor;
+      kSideError * (std::abs(p.nd.x) * M.x + std::abs(p.nd.y) * M.y + std::abs(p.nd.z) * M.z +
+                    p.da() * v.MW()) +
+      kDoubleFloor;
   if (value > bound) return 1;
   if (value < -bound) return -1;
   return 2;
@@ -782,7 +790,8 @@ int double_side(const Plane& p, const HVertex& v) {
 int double_compare(const Plane& p, const HVertex& u, const HVertex& v) {
   if (!p.fast || !u.fast || !v.fast) return 2;
   const double nu = dot(p.nd, u.Xd()), nv = dot(p.nd, v.Xd());
-  const double mu = dot(p.na, u.MX()), mv = dot(p.na, v.MX());
+  const V3<double> na = p.na();
+  const double mu = dot(na, u.MX()), mv = dot(na, v.MX());
   const double value = nu * v.Wd() - nv * u.Wd();
   const double bound = kCompareError * (mu * v.MW() + mv * u.MW()) + kDoubleFloor;
   if (value > bound) return 1;
@@ -794,9 +803,9 @@ int double_compare(const Plane& p, const HVertex& u, const HVertex& v) {
 /// here (not kept: v may be shared between threads).
 int interval_side(const std::vector<Plane>& planes, const Plane& p, const HVertex& v) {
   if (v.intervals) return interval_sign(dot(p.ni, v.Xi) - p.di * v.Wi);
-  V3<Interval> Xi, xi;
+  V3<Interval> Xi;
   Interval Wi;
-  interval_meet(planes, v.planes, Xi, Wi, xi);
+  interval_meet(planes, v.planes, Xi, Wi);
   return interval_sign(dot(p.ni, Xi) - p.di * Wi);
 }
 
@@ -874,11 +883,14 @@ int compare_filter(const std::vector<Plane>& planes, const PrecisePlanes& precis
   };
   const auto interval_sign_of = [&] {
     // (Intervals made here where a vertex has none: not kept, the vertices are shared.)
-    V3<Interval> Xi, ui, vi;
-    Interval Wi;
-    if (!u.intervals) interval_meet(planes, u.planes, Xi, Wi, ui);
-    if (!v.intervals) interval_meet(planes, v.planes, Xi, Wi, vi);
-    return interval_sign(dot(p.ni, u.intervals ? u.xi : ui) - dot(p.ni, v.intervals ? v.xi : vi));
+    const auto enclosure = [&](const HVertex& x) {
+      if (x.intervals) return quotient(x.Xi, x.Wi);
+      V3<Interval> Xi;
+      Interval Wi;
+      interval_meet(planes, x.planes, Xi, Wi);
+      return quotient(Xi, Wi);
+    };
+    return interval_sign(dot(p.ni, enclosure(u)) - dot(p.ni, enclosure(v)));
   };
   if (stage && precise.made(i)) {
     const int t = precise_sign();
@@ -949,20 +961,40 @@ double step_away(double r, bool away) {
     const double up = step_away(r, r > 0) - r, down = r - step_away(r, r < 0);
     return R + error < 0.5 * up * w_low && R - error > -0.5 * down * w_low;
   };
-  // X.hi / W.hi (as X.hi times the inverse) is within an ulp or two of X / W, and often its
-  // rounding already: tested first; otherwise moved by the residual, X / W to about 100
-  // bits, and tested again.
+  // X.hi / W.hi (as X.hi times the inverse) is within an ulp or two of X / W, q1; moved by
+  // its residual, X / W to about 100 bits, r: the rounding, unless X / W is near a midpoint.
+  // q1 alone is the rounding in only about a quarter of the calls (an opening's), so testing
+  // it first cost a mispredicted branch in most; r is tested instead, with its residual
+  // R1 - (r - q1) W from q1's (r - q1 exact: Sterbenz), q1 only where r fails.
   const double q1 = X.hi * inverse;
   if (!(std::abs(q1) >= 0x1p-490 && std::abs(q1) <= 0x1p490)) return false;
   const double R1 = residual(q1);
-  if (rounds_to(q1, R1)) {
-    out = q1;
-    return true;
-  }
+  const double sum1 = sum;
   const double r = q1 + R1 * inverse;
-  if (!(std::abs(r) >= 0x1p-500 && std::abs(r) <= 0x1p500)) return false;
-  if (!rounds_to(r, residual(r))) return false;
-  out = r;
+  const double ar = std::abs(r), aq = std::abs(q1);
+  if (ar >= 0x1p-500 && ar <= 0x1p500 && (r > 0) == (q1 > 0) && ar <= 2 * aq && aq <= 2 * ar) {
+    // delta exact; t = delta W.hi and t_lo = delta W.lo rounded (by at most u (1 + u) of
+    // each, plus underflow in t_lo: rounds_to's 2^-1000), and two subtractions (u of each
+    // exact result): within 2.01 u (|R1| + |t| + |t_lo| + |R2|) of the residual of the
+    // double-double X and W, besides R1's own error (2^-50 (sum1 + |R1|)). rounds_to
+    // counts 2^-50 (sum + |R2|): sum takes sum1, 2 |R1|, |t| and |t_lo|.
+    const double delta = r - q1;
+    const double t = delta * W.hi, t_lo = delta * W.lo;
+    const double R2 = (R1 - t) - t_lo;
+    sum = sum1 + 2 * std::abs(R1) + std::abs(t) + std::abs(t_lo);
+    if (rounds_to(r, R2)) {
+      out = r;
+      return true;
+    }
+  } else if (ar >= 0x1p-500 && ar <= 0x1p500) {
+    if (rounds_to(r, residual(r))) {  // (out of Sterbenz's range: not seen in practice)
+      out = r;
+      return true;
+    }
+  }
+  sum = sum1;
+  if (!rounds_to(q1, R1)) return false;
+  out = q1;
   return true;
 }
 
@@ -1056,8 +1088,10 @@ bool clockwise(const std::vector<int>& cyc, const std::vector<HVertex>& vertex,
   const int n = static_cast<int>(cyc.size());
   {
     RoundingGuard guard;
+    std::vector<V3<Interval>> x(n);
+    for (int i = 0; i < n; ++i) x[i] = quotient(vertex[cyc[i]].Xi, vertex[cyc[i]].Wi);
     const V3<Interval> nw =
-        newell_normal<Interval>(n, [&](int i) -> const V3<Interval>& { return vertex[cyc[i]].xi; });
+        newell_normal<Interval>(n, [&](int i) -> const V3<Interval>& { return x[i]; });
     const int s = interval_sign(dot(nw, to_interval_n(normal)));
     if (s != 2) return s < 0;
   }
@@ -1990,7 +2024,16 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     const auto coordinate = [](const auto& p, int i) -> const auto& {
       return i == 0 ? p.x : i == 1 ? p.y : p.z;
     };
+    // The vertices are read in the output's order, scattered over the array: the records a
+    // few ahead are fetched while this one rounds (its flags and precise coordinates span
+    // two cache lines).
+    constexpr int kAhead = 6;
     for (int r = begin; r < end; ++r) {
+      if (r + kAhead < end) {
+        const HVertex& ahead = vertex[order[r + kAhead]];
+        __builtin_prefetch(&ahead.px);
+        __builtin_prefetch(&ahead.ew);
+      }
       const HVertex& v = vertex[order[r]];
       double rounded[3];
       const double inverse = v.precise ? 1 / v.pw.hi : 0;
@@ -2010,7 +2053,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
         // (Any estimate serves: round_quotient only starts from it.)
         const double q = v.intervals ? 0 : coordinate(v.Xd(), i) / v.Wd();
         const Interval estimate =
-            v.intervals ? coordinate(v.xi, i) : Interval(std::isfinite(q) ? q : 0.0);
+            v.intervals ? coordinate(v.Xi, i) / v.Wi : Interval(std::isfinite(q) ? q : 0.0);
         rounded[i] = round_quotient(coordinate(*e.X, i), *e.W, estimate);
       }
       rp.points[r] = {rounded[0], rounded[1], rounded[2]};
@@ -2115,7 +2158,6 @@ class IncrementalHull {
       } else {
         v.Xi = tri.Xi;
         v.Wi = tri.Wi;
-        v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
         v.intervals = true;
         if (tri.precise >= 0) {
           const HVertex& q = precise_vertex_[tri.precise];
@@ -2627,13 +2669,12 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
     } else {
       const Plane &a = planes[p[i]], &b = planes[p[j]];
       scratch.dcross[at] = cross(a.nd, b.nd);
-      scratch.mcross[at] = magnitude_cross(a.na, b.na);
+      scratch.mcross[at] = magnitude_cross(a.na(), b.na());
     }
     scratch.has_cross[at] = 1;
     return at;
   };
-  // Triangle t's vertex, as vertex_of(planes, abc, known) computes it but for xi, which
-  // the flips' tests do not use: made for the final triangles only.
+  // Triangle t's vertex, as vertex_of(planes, abc, known) computes it.
   const auto compute_vertex = [&](int t) {
     ready[t] = 1;
     const auto [i, j, l] = triangle[t];
@@ -2657,7 +2698,7 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
       v.intervals = true;
       v.fast = false;
     }
-    take_known(known, v);  // (a known point's xi is set)
+    take_known(known, v);
   };
   // Triangle t's vertex (computed when first tested); false when t is not positively
   // oriented.
@@ -2722,8 +2763,6 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
       out_far[3 * t + m] = diagonal(x, y) ? diagonal_side(x, y) : 2;
     }
     if (!ready[t]) compute_vertex(static_cast<int>(t));
-    HVertex& v = vertex[t];
-    if (v.known < 0 && v.intervals) v.xi = {v.Xi.x / v.Wi, v.Xi.y / v.Wi, v.Xi.z / v.Wi};
     out_has[t] = 1;
   }
   return true;
@@ -2767,12 +2806,23 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const PrecisePlan
   if (!ok) return {};
   // Directed edges 3 t + k (corner k to k + 1 of triangle t) listed by their first plane
   // (a counting sort), each with its second plane: each edge's reverse is the one edge back
-  // among the few leaving its second plane.
+  // among the few leaving its second plane. Only edges a -> b with a < b search (the search's
+  // variable length cost a mispredicted exit each); each sets its reverse's `across` too.
+  // Every edge has exactly one reverse (a closed surface, each edge used once) iff each
+  // search finds exactly one, every edge b -> a with b > a is reached, and there are as many
+  // of those as of the searching ones (then the searches pair them one to one).
   const auto next_corner = [](int k) { return k == 2 ? 0 : k + 1; };
   std::vector<int> out_begin(planes.size() + 1, 0), out_edge(3 * static_cast<std::size_t>(nt)),
       out_head(out_edge.size());
+  std::ptrdiff_t balance = 0;  // edges a -> b with a < b, less those with a > b
   for (const auto& c : s.corner)
-    for (int a : c) ++out_begin[a + 1];
+    for (int k = 0; k < 3; ++k) {
+      ++out_begin[c[k] + 1];
+      const int a = c[k], b = c[next_corner(k)];
+      if (a == b) return {};
+      balance += a < b ? 1 : -1;
+    }
+  if (balance != 0) return {};
   std::partial_sum(out_begin.begin(), out_begin.end(), out_begin.begin());
   {
     std::vector<int> next(out_begin.begin(), out_begin.end() - 1);
@@ -2783,19 +2833,27 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const PrecisePlan
         out_head[j] = s.corner[t][next_corner(k)];
       }
   }
-  s.across.resize(nt);
+  s.across.assign(nt, {-1, -1, -1});
   parallel_chunks(nt, 1024, [&](int begin, int end) {
     for (int t = begin; t < end && ok; ++t)
       for (int k = 0; k < 3; ++k) {
         const int a = s.corner[t][k], b = s.corner[t][next_corner(k)];
+        if (a > b) continue;  // set by its reverse's search
         int back = -1, found = 0;
         for (int j = out_begin[b]; j < out_begin[b + 1]; ++j)
           if (out_head[j] == a) back = out_edge[j], ++found;
-        if (found != 1) ok = false;  // an open surface, or an edge used twice
+        if (found != 1) {
+          ok = false;  // an open surface, or an edge used twice
+          break;
+        }
         s.across[t][k] = back / 3;
+        // (Atomic: two searches reach one edge where the surface is not closed.)
+        std::atomic_ref<int>(s.across[back / 3][back % 3]).store(t, std::memory_order_relaxed);
       }
   });
   if (!ok) return {};
+  for (const auto& u : s.across)
+    if (u[0] < 0 || u[1] < 0 || u[2] < 0) return {};
   return s;
 }
 
