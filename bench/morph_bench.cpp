@@ -30,8 +30,6 @@
 #include <morph/morphology.h>
 #include <morph/structuring_element.h>
 #include <sys/resource.h>
-
-#include "common/allocator.h"
 #include <unistd.h>
 
 #include <algorithm>
@@ -48,6 +46,8 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+#include "common/allocator.h"
 
 namespace {
 
@@ -625,8 +625,7 @@ int main(int argc, char** argv) {
     Settings settings;
     const std::vector<std::string> args(argv + 1, argv + argc);
     // Before any allocation of either route: both are timed with the same allocator settings.
-    g_malloc_defaults =
-        std::find(args.begin(), args.end(), "--malloc-defaults") != args.end();
+    g_malloc_defaults = std::find(args.begin(), args.end(), "--malloc-defaults") != args.end();
     if (!g_malloc_defaults) morph::cli::keep_freed_memory();
     if (args.size() == 3 && args[0] == "--peak-case")
       return run_peak_case(args[1], std::stoi(args[2]));

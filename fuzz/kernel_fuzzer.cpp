@@ -13,9 +13,6 @@
 #include <morph/morphology.h>
 #include <morph/validate.h>
 
-#include "support/oracle.h"
-#include "support/polytopes.h"
-
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -25,6 +22,9 @@
 #include <cstring>
 #include <stdexcept>
 #include <vector>
+
+#include "support/oracle.h"
+#include "support/polytopes.h"
 
 namespace {
 
@@ -60,9 +60,10 @@ std::vector<Point> decode_points(Bytes& in, int mode) {
     for (int k = 0; k < 3; ++k) p[k] = mode == 0 ? in.byte() % 9 - 4 : in.int16() / 4096.0;
     if (mode == 2 && norm > 1e-3) {
       const double w = q[0] / norm, x = q[1] / norm, y = q[2] / norm, z = q[3] / norm;
-      const double m[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
-                           2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-                           2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
+      const double m[9] = {
+          1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
+          2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+          2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
       p = Point(m[0] * p[0] + m[1] * p[1] + m[2] * p[2], m[3] * p[0] + m[4] * p[1] + m[5] * p[2],
                 m[6] * p[0] + m[7] * p[1] + m[8] * p[2]);
     }

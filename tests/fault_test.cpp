@@ -1,13 +1,12 @@
 // Faults and hardening: writes that fail (disk full, unwritable directory, devices),
 // inputs left untouched, structuring-element bounds, and replay of the fuzz corpora
 // (tests/fuzz_corpus: seeds and every input that once crashed or hung a fuzz target).
+#include <doctest/doctest.h>
 #include <morph/error.h>
 #include <morph/io.h>
 #include <morph/morphology.h>
 #include <morph/structuring_element.h>
 #include <morph/validate.h>
-
-#include <doctest/doctest.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
 #include <unistd.h>
@@ -32,7 +31,8 @@ std::size_t hash_file(const fs::path& path) { return std::hash<std::string>{}(re
 
 // A fresh empty directory under the system temporary directory.
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("morph_fault_" + name + "_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("morph_fault_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -126,14 +126,18 @@ TEST_CASE("limits: structuring-element parameters are bounded with clear errors"
     }
     return std::string("(accepted)");
   };
-  CHECK(message("sphere:r=1,level=8").find("sphere level must be an integer in 0..7") != std::string::npos);
+  CHECK(message("sphere:r=1,level=8").find("sphere level must be an integer in 0..7") !=
+        std::string::npos);
   // Found by fuzz_se_spec: n=4096 meant 16.7 million faces; now n^2 <= 262,144.
-  CHECK(message("uvsphere:r=1,n=513").find("uvsphere n must be an integer in 3..512") != std::string::npos);
-  CHECK(message("cylinder:r=1,h=1,n=4097").find("cylinder n must be an integer in 3..4096") != std::string::npos);
+  CHECK(message("uvsphere:r=1,n=513").find("uvsphere n must be an integer in 3..512") !=
+        std::string::npos);
+  CHECK(message("cylinder:r=1,h=1,n=4097").find("cylinder n must be an integer in 3..4096") !=
+        std::string::npos);
   CHECK(morph::make_structuring_element("cylinder:r=1,h=1,n=4096").n_faces() == 4098);
   // Found by fuzz_se_spec: at r=1e-100 every facet had zero area for validation.
   CHECK(message("sphere:r=1e-51").find("between 1e-50 and 1e50") != std::string::npos);
-  for (const char* spec : {"sphere:r=1e-50", "cube:1e-50", "box:1e-50,2e-50,3e-50", "sphere:r=1e50"})
+  for (const char* spec :
+       {"sphere:r=1e-50", "cube:1e-50", "box:1e-50,2e-50,3e-50", "sphere:r=1e50"})
     CHECK_MESSAGE(morph::check_convex_polyhedron(morph::make_structuring_element(spec)).ok(),
                   std::string(spec));
 }

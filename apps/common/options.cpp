@@ -1,7 +1,5 @@
 #include "options.h"
 
-#include "allocator.h"
-
 #include <morph/error.h>
 #include <morph/io.h>
 #include <morph/structuring_element.h>
@@ -9,6 +7,8 @@
 
 #include <iostream>
 #include <sstream>
+
+#include "allocator.h"
 
 namespace morph::cli {
 
@@ -92,7 +92,8 @@ std::string label_palette_help() {
          "  corner      230 159 0   orange  a facet of the element placed at a vertex of the "
          "input\n"
          "  edge        0 158 115   green   a parallelogram: an input edge (+) an element edge\n"
-         "  (an erosion's facets are facets of the input moved inwards by a vertex of the element:\n"
+         "  (an erosion's facets are facets of the input moved inwards by a vertex of the "
+         "element:\n"
          "  translated; a closing's are the translated facets of the dilation they lie on)\n";
 }
 

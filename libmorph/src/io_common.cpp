@@ -429,7 +429,8 @@ mode_t new_file_mode() {
 
 // Writes `bytes` to a temporary file beside `target`, syncs it and renames it over the
 // target. On any failure the temporary is removed and the target is untouched.
-void write_in_place(const std::filesystem::path& target, const std::string& name, std::string_view bytes) {
+void write_in_place(const std::filesystem::path& target, const std::string& name,
+                    std::string_view bytes) {
   const int fd = ::open(target.c_str(), O_WRONLY | O_CLOEXEC);
   if (fd < 0) throw io_error(name + ": cannot open for writing: " + errno_text(errno));
   for (std::size_t done = 0; done < bytes.size();) {
@@ -456,7 +457,8 @@ void write_atomically(const std::filesystem::path& requested, std::string_view b
   // A device or FIFO (/dev/null, /dev/stdout, /dev/full) is written in place: renaming a
   // temporary over it would replace the device node with a regular file and hide errors.
   struct stat special {};
-  if (::stat(target.c_str(), &special) == 0 && !S_ISREG(special.st_mode) && !S_ISDIR(special.st_mode)) {
+  if (::stat(target.c_str(), &special) == 0 && !S_ISREG(special.st_mode) &&
+      !S_ISDIR(special.st_mode)) {
     write_in_place(target, name, bytes);
     return;
   }

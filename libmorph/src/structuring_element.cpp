@@ -31,9 +31,9 @@ namespace morph {
 namespace {
 
 // Limits on the parameters: beyond them a spec is a mistake, not a structuring element.
-constexpr int kMaxIcosphereLevel = 7;  // 327,680 triangles
-constexpr int kMinSides = 3;           // fewest sides of a polygon
-constexpr int kMaxSides = 4096;        // n of a cylinder (n + 2 faces)
+constexpr int kMaxIcosphereLevel = 7;   // 327,680 triangles
+constexpr int kMinSides = 3;            // fewest sides of a polygon
+constexpr int kMaxSides = 4096;         // n of a cylinder (n + 2 faces)
 constexpr int kMaxUvSphereSides = 512;  // n of a uvsphere: n^2 faces, 262,144 at most (as level 7)
 // Radii, edges: cubes of these stay finite in double, and squared facet areas (~extent^4,
 // as validation computes them) stay above underflow: at 1e-100 every facet had zero area.

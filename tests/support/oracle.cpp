@@ -1,8 +1,6 @@
 // The oracle's exact machinery (CGAL). See oracle.h.
 #include "support/oracle.h"
 
-#include "support/polytopes.h"
-
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Exact_rational.h>
@@ -20,11 +18,13 @@
 #include <stdexcept>
 #include <utility>
 
+#include "support/polytopes.h"
+
 namespace morph::test {
 namespace {
 
-using EK = CGAL::Epeck;   // exact constructions: hulls of exact sums
-using IK = CGAL::Epick;   // exact predicates on double points: mesh checks
+using EK = CGAL::Epeck;  // exact constructions: hulls of exact sums
+using IK = CGAL::Epick;  // exact predicates on double points: mesh checks
 using EPoint = EK::Point_3;
 using IPoint = IK::Point_3;
 using Q = CGAL::Exact_rational;
@@ -74,7 +74,8 @@ Position position(const Point& p) { return {p[0], p[1], p[2]}; }
 
 bool representable(const EPoint& p) {
   const Position r = rounded(p);
-  return Q(r[0]) == CGAL::exact(p.x()) && Q(r[1]) == CGAL::exact(p.y()) && Q(r[2]) == CGAL::exact(p.z());
+  return Q(r[0]) == CGAL::exact(p.x()) && Q(r[1]) == CGAL::exact(p.y()) &&
+         Q(r[2]) == CGAL::exact(p.z());
 }
 
 // The plane of a polygon by Newell's normal through its centroid; zero normal when the
@@ -84,7 +85,8 @@ Plane newell_plane(const std::vector<Point>& p) {
   for (std::size_t i = 0; i < p.size(); ++i) {
     const Point& a = p[i];
     const Point& b = p[(i + 1) % p.size()];
-    n += Point((a[1] - b[1]) * (a[2] + b[2]), (a[2] - b[2]) * (a[0] + b[0]), (a[0] - b[0]) * (a[1] + b[1]));
+    n += Point((a[1] - b[1]) * (a[2] + b[2]), (a[2] - b[2]) * (a[0] + b[0]),
+               (a[0] - b[0]) * (a[1] + b[1]));
     centroid += a;
   }
   centroid /= static_cast<double>(p.size());
@@ -101,9 +103,9 @@ double signed_distance(const Plane& h, const Point& p) {
 // Exact convex hull with polygon facets
 
 struct ExactHull {
-  std::vector<EPoint> points;                // extreme points only
-  std::vector<std::vector<int>> facets;      // cyclic, counter-clockwise from outside
-  std::vector<Plane> planes;                 // approximate, one per facet
+  std::vector<EPoint> points;            // extreme points only
+  std::vector<std::vector<int>> facets;  // cyclic, counter-clockwise from outside
+  std::vector<Plane> planes;             // approximate, one per facet
   Q volume;
 };
 
@@ -143,12 +145,14 @@ Plane approximate_plane(const EK::Plane_3& plane, const EPoint& on) {
   Plane out;
   for (int k = 0; k < 3; ++k) out.normal[k] = n[k] / len;
   out.offset = out.normal[0] * CGAL::to_double(CGAL::exact(on.x())) +
-               out.normal[1] * CGAL::to_double(CGAL::exact(on.y())) + out.normal[2] * CGAL::to_double(CGAL::exact(on.z()));
+               out.normal[1] * CGAL::to_double(CGAL::exact(on.y())) +
+               out.normal[2] * CGAL::to_double(CGAL::exact(on.z()));
   return out;
 }
 
 ExactHull exact_hull(const std::vector<EPoint>& input) {
-  if (affine_dimension(input) != 3) throw std::invalid_argument("exact_hull: points do not span a solid");
+  if (affine_dimension(input) != 3)
+    throw std::invalid_argument("exact_hull: points do not span a solid");
   HullMesh sm;
   CGAL::convex_hull_3(input.begin(), input.end(), sm);
 
@@ -159,8 +163,8 @@ ExactHull exact_hull(const std::vector<EPoint>& input) {
     const auto f = sm.face(h);
     const auto g = sm.face(sm.opposite(h));
     const auto far = sm.target(sm.next(sm.opposite(h)));
-    if (CGAL::coplanar(sm.point(sm.source(h)), sm.point(sm.target(h)), sm.point(sm.target(sm.next(h))),
-                       sm.point(far))) {
+    if (CGAL::coplanar(sm.point(sm.source(h)), sm.point(sm.target(h)),
+                       sm.point(sm.target(sm.next(h))), sm.point(far))) {
       groups.unite(static_cast<int>(f.idx()), static_cast<int>(g.idx()));
     }
   }
@@ -170,7 +174,8 @@ ExactHull exact_hull(const std::vector<EPoint>& input) {
   ExactHull hull;
   for (auto v : sm.vertices()) {
     std::set<int> around;
-    for (auto f : CGAL::faces_around_target(sm.halfedge(v), sm)) around.insert(groups.find(f.idx()));
+    for (auto f : CGAL::faces_around_target(sm.halfedge(v), sm))
+      around.insert(groups.find(f.idx()));
     if (around.size() >= 3) {
       new_index[v.idx()] = static_cast<int>(hull.points.size());
       hull.points.push_back(sm.point(v));
@@ -199,7 +204,8 @@ ExactHull exact_hull(const std::vector<EPoint>& input) {
     do {
       if (new_index[v] >= 0) cycle.push_back(new_index[v]);
       v = next.at(v);
-      if (cycle.size() > next.size()) throw std::logic_error("exact_hull: facet boundary is not a cycle");
+      if (cycle.size() > next.size())
+        throw std::logic_error("exact_hull: facet boundary is not a cycle");
     } while (v != start);
     hull.facets.push_back(std::move(cycle));
     hull.planes.push_back(approximate_plane(group_plane.at(g), group_point.at(g)));
@@ -234,7 +240,8 @@ Description describe_hull(const ExactHull& hull) {
     degrees += facet.size();
     facets.emplace_back(std::move(facet), hull.planes[f]);
   }
-  std::sort(facets.begin(), facets.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::sort(facets.begin(), facets.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
   for (auto& [facet, plane] : facets) {
     d.facets.push_back(std::move(facet));
     d.planes.push_back(plane);
@@ -258,7 +265,9 @@ QVec cross(const QVec& a, const QVec& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 Q dot(const QVec& a, const QVec& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-bool is_zero(const QVec& a) { return CGAL::is_zero(a.x) && CGAL::is_zero(a.y) && CGAL::is_zero(a.z); }
+bool is_zero(const QVec& a) {
+  return CGAL::is_zero(a.x) && CGAL::is_zero(a.y) && CGAL::is_zero(a.z);
+}
 QVec qvec(const Point& p) { return {Q(p[0]), Q(p[1]), Q(p[2])}; }
 
 struct QPlane {  // n.x <= d
@@ -349,7 +358,8 @@ Description exact_hull_of_sums(const Mesh& A, const Mesh& B) {
     const Point& a = A.point(va);
     for (auto vb : B.vertices()) {
       const Point& b = B.point(vb);
-      sums.emplace_back(EK::FT(Q(a[0]) + Q(b[0])), EK::FT(Q(a[1]) + Q(b[1])), EK::FT(Q(a[2]) + Q(b[2])));
+      sums.emplace_back(EK::FT(Q(a[0]) + Q(b[0])), EK::FT(Q(a[1]) + Q(b[1])),
+                        EK::FT(Q(a[2]) + Q(b[2])));
     }
   }
   return describe_hull(exact_hull(sums));
@@ -365,7 +375,8 @@ Description describe(const Mesh& mesh) {
   for (auto f : mesh.faces()) {
     std::vector<Point> p;
     for (auto v : mesh.fv_range(f)) p.push_back(mesh.point(v));
-    for (std::size_t i = 1; i + 1 < p.size(); ++i) volume += OpenMesh::dot(p[0], OpenMesh::cross(p[i], p[i + 1]));
+    for (std::size_t i = 1; i + 1 < p.size(); ++i)
+      volume += OpenMesh::dot(p[0], OpenMesh::cross(p[i], p[i + 1]));
     Plane plane = newell_plane(p);
     {
       // Newell's vector is twice the area; below ~1e-12 of the face's extent squared its
@@ -382,7 +393,8 @@ Description describe(const Mesh& mesh) {
     degrees += facet.size();
     facets.emplace_back(std::move(facet), plane);
   }
-  std::sort(facets.begin(), facets.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::sort(facets.begin(), facets.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
   for (auto& [facet, plane] : facets) {
     d.facets.push_back(std::move(facet));
     d.planes.push_back(plane);
@@ -398,7 +410,8 @@ namespace {
 
 // The exact vertices of A (-) B (empty when B fits nowhere).
 std::vector<EPoint> erosion_points(const Mesh& A, const Mesh& B) {
-  if (A.n_vertices() == 0 || B.n_vertices() == 0) throw std::invalid_argument("exact_erosion: empty operand");
+  if (A.n_vertices() == 0 || B.n_vertices() == 0)
+    throw std::invalid_argument("exact_erosion: empty operand");
   std::vector<QVec> b_points;
   for (auto v : B.vertices()) b_points.push_back(qvec(B.point(v)));
 
@@ -409,7 +422,8 @@ std::vector<EPoint> erosion_points(const Mesh& A, const Mesh& B) {
     hi.maximize(A.point(v));
   }
   const double margin = (hi - lo).norm() + 1.0;
-  const QVec qlo = qvec(lo - Point(margin, margin, margin)), qhi = qvec(hi + Point(margin, margin, margin));
+  const QVec qlo = qvec(lo - Point(margin, margin, margin)),
+             qhi = qvec(hi + Point(margin, margin, margin));
   std::vector<QPlane> planes = {
       normalized({{Q(-1), Q(0), Q(0)}, -qlo.x}), normalized({{Q(1), Q(0), Q(0)}, qhi.x}),
       normalized({{Q(0), Q(-1), Q(0)}, -qlo.y}), normalized({{Q(0), Q(1), Q(0)}, qhi.y}),
@@ -421,7 +435,8 @@ std::vector<EPoint> erosion_points(const Mesh& A, const Mesh& B) {
     for (const QVec& b : b_points) support = CGAL::max(support, dot(h.n, b));
     h.d -= support;
     h = normalized(h);
-    if (std::none_of(planes.begin(), planes.end(), [&](const QPlane& g) { return same(g, h); })) planes.push_back(h);
+    if (std::none_of(planes.begin(), planes.end(), [&](const QPlane& g) { return same(g, h); }))
+      planes.push_back(h);
   }
 
   std::vector<DDVertex> verts;
@@ -455,8 +470,9 @@ std::vector<EPoint> erosion_points(const Mesh& A, const Mesh& B) {
         for (std::size_t j = 0; j < verts.size(); ++j) {
           if (sign[j] <= 0) continue;
           std::vector<int> common;
-          std::set_intersection(verts[i].tight.begin(), verts[i].tight.end(), verts[j].tight.begin(),
-                                verts[j].tight.end(), std::back_inserter(common));
+          std::set_intersection(verts[i].tight.begin(), verts[i].tight.end(),
+                                verts[j].tight.begin(), verts[j].tight.end(),
+                                std::back_inserter(common));
           if (common.size() < 2 || normal_rank(common, planes) != 2) continue;  // not an edge
           const Q t = value[i] / (value[i] - value[j]);
           const QVec& u = verts[i].p;
@@ -474,7 +490,8 @@ std::vector<EPoint> erosion_points(const Mesh& A, const Mesh& B) {
 
   std::vector<EPoint> pts;
   for (const DDVertex& v : verts) {
-    if (v.tight.front() < box_planes) throw std::logic_error("exact_erosion: result touches the bounding box");
+    if (v.tight.front() < box_planes)
+      throw std::logic_error("exact_erosion: result touches the bounding box");
     pts.emplace_back(EK::FT(v.p.x), EK::FT(v.p.y), EK::FT(v.p.z));
   }
   return pts;
@@ -523,7 +540,8 @@ std::string text(const Position& p) {
 std::string first_difference(const std::vector<Position>& got, const std::vector<Position>& want) {
   std::vector<Position> extra, missing;
   std::set_difference(got.begin(), got.end(), want.begin(), want.end(), std::back_inserter(extra));
-  std::set_difference(want.begin(), want.end(), got.begin(), got.end(), std::back_inserter(missing));
+  std::set_difference(want.begin(), want.end(), got.begin(), got.end(),
+                      std::back_inserter(missing));
   std::ostringstream s;
   if (!extra.empty()) s << extra.size() << " unexpected, e.g. " << text(extra.front()) << "; ";
   if (!missing.empty()) s << missing.size() << " missing, e.g. " << text(missing.front());
@@ -537,7 +555,9 @@ bool volume_close(double got, double want, double rel) {
 double excess(const Position& v, const std::vector<Plane>& planes) {
   double worst = -std::numeric_limits<double>::infinity();
   for (const Plane& h : planes) {
-    if (h.reliable) worst = std::max(worst, h.normal[0] * v[0] + h.normal[1] * v[1] + h.normal[2] * v[2] - h.offset);
+    if (h.reliable)
+      worst =
+          std::max(worst, h.normal[0] * v[0] + h.normal[1] * v[1] + h.normal[2] * v[2] - h.offset);
   }
   return worst;
 }
@@ -549,18 +569,22 @@ std::string compare_exact(const Description& got, const Description& want, doubl
   s.precision(17);
   if (got.vertex_count != want.vertex_count || got.facet_count != want.facet_count ||
       got.edge_count != want.edge_count) {
-    s << "counts V/E/F " << got.vertex_count << "/" << got.edge_count << "/" << got.facet_count << ", expected "
-      << want.vertex_count << "/" << want.edge_count << "/" << want.facet_count << ". ";
+    s << "counts V/E/F " << got.vertex_count << "/" << got.edge_count << "/" << got.facet_count
+      << ", expected " << want.vertex_count << "/" << want.edge_count << "/" << want.facet_count
+      << ". ";
   }
-  if (got.vertices != want.vertices) s << "vertices differ: " << first_difference(got.vertices, want.vertices) << ". ";
+  if (got.vertices != want.vertices)
+    s << "vertices differ: " << first_difference(got.vertices, want.vertices) << ". ";
   if (got.facets != want.facets) {
     std::vector<std::vector<Position>> extra, missing;
-    std::set_difference(got.facets.begin(), got.facets.end(), want.facets.begin(), want.facets.end(),
-                        std::back_inserter(extra));
-    std::set_difference(want.facets.begin(), want.facets.end(), got.facets.begin(), got.facets.end(),
-                        std::back_inserter(missing));
+    std::set_difference(got.facets.begin(), got.facets.end(), want.facets.begin(),
+                        want.facets.end(), std::back_inserter(extra));
+    std::set_difference(want.facets.begin(), want.facets.end(), got.facets.begin(),
+                        got.facets.end(), std::back_inserter(missing));
     s << "facets differ: " << extra.size() << " unexpected, " << missing.size() << " missing";
-    if (!missing.empty()) s << " (e.g. a " << missing.front().size() << "-gon at " << text(missing.front().front()) << ")";
+    if (!missing.empty())
+      s << " (e.g. a " << missing.front().size() << "-gon at " << text(missing.front().front())
+        << ")";
     s << ". ";
   }
   if (!volume_close(got.volume, want.volume, volume_rel_tol)) {
@@ -575,7 +599,8 @@ double max_excess(const Description& inner, const Description& outer) {
   return worst;
 }
 
-std::string compare_close(const Description& got, const Description& want, double dist_tol, double volume_rel_tol) {
+std::string compare_close(const Description& got, const Description& want, double dist_tol,
+                          double volume_rel_tol) {
   std::ostringstream s;
   s.precision(17);
   if (got.vertices.empty() || want.vertices.empty()) {
@@ -593,8 +618,12 @@ std::string compare_close(const Description& got, const Description& want, doubl
 }
 
 std::string subresolution_feature(const Description& d, double tol) {
-  auto sub = [](const Position& a, const Position& b) { return Position{a[0] - b[0], a[1] - b[1], a[2] - b[2]}; };
-  auto dot3 = [](const Position& a, const Position& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
+  auto sub = [](const Position& a, const Position& b) {
+    return Position{a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+  };
+  auto dot3 = [](const Position& a, const Position& b) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  };
   auto length = [&](const Position& a) { return std::sqrt(dot3(a, a)); };
   std::map<Position, std::vector<std::size_t>> facets_at;
   for (std::size_t f = 0; f < d.facets.size(); ++f)
@@ -627,7 +656,8 @@ std::string subresolution_feature(const Description& d, double tol) {
     for (const Position& p : fp) {
       const Position r = sub(p, fp[a]);
       const double along = dot3(r, axis) / dot3(axis, axis);
-      width = std::max(width, length(sub(r, Position{along * axis[0], along * axis[1], along * axis[2]})));
+      width = std::max(width,
+                       length(sub(r, Position{along * axis[0], along * axis[1], along * axis[2]})));
     }
     if (width < tol) return "a facet thinner than the feature size";
   }
@@ -651,7 +681,8 @@ std::string subresolution_feature(const Description& d, double tol) {
 bool exactly_planar(const Mesh& mesh) {
   for (auto f : mesh.faces()) {
     std::vector<IPoint> p;
-    for (auto v : mesh.fv_range(f)) p.emplace_back(mesh.point(v)[0], mesh.point(v)[1], mesh.point(v)[2]);
+    for (auto v : mesh.fv_range(f))
+      p.emplace_back(mesh.point(v)[0], mesh.point(v)[1], mesh.point(v)[2]);
     if (affine_dimension(p) != 2) return false;
   }
   return true;
@@ -684,10 +715,13 @@ bool identical(const Mesh& a, const Mesh& b) {
 std::string clean_mesh_problem(const Mesh& mesh, const CleanOptions& options) {
   if (mesh.n_vertices() == 0 || mesh.n_faces() == 0) return "the mesh is empty";
   for (auto h : mesh.halfedges()) {
-    if (mesh.is_boundary(h)) return "not closed: a boundary halfedge at vertex " + std::to_string(mesh.from_vertex_handle(h).idx());
+    if (mesh.is_boundary(h))
+      return "not closed: a boundary halfedge at vertex " +
+             std::to_string(mesh.from_vertex_handle(h).idx());
   }
   for (auto e : mesh.edges()) {
-    if (mesh.face_handle(mesh.halfedge_handle(e, 0)) == mesh.face_handle(mesh.halfedge_handle(e, 1))) {
+    if (mesh.face_handle(mesh.halfedge_handle(e, 0)) ==
+        mesh.face_handle(mesh.halfedge_handle(e, 1))) {
       return "edge " + std::to_string(e.idx()) + " has the same face on both sides";
     }
   }
@@ -786,12 +820,15 @@ std::string clean_mesh_problem(const Mesh& mesh, const CleanOptions& options) {
   };
   for (auto f : mesh.faces()) {
     for (auto v : mesh.vertices()) {
-      if (above(f, v)) return "not convex: vertex " + std::to_string(v.idx()) + " above face " + std::to_string(f.idx());
+      if (above(f, v))
+        return "not convex: vertex " + std::to_string(v.idx()) + " above face " +
+               std::to_string(f.idx());
     }
   }
   if (!options.exact) {
     for (auto v : mesh.vertices()) {
-      if (mesh.valence(v) < 3) return "not minimal: vertex " + std::to_string(v.idx()) + " has fewer than 3 faces";
+      if (mesh.valence(v) < 3)
+        return "not minimal: vertex " + std::to_string(v.idx()) + " has fewer than 3 faces";
     }
     return {};
   }
@@ -799,17 +836,20 @@ std::string clean_mesh_problem(const Mesh& mesh, const CleanOptions& options) {
     const auto f = mesh.face_handle(mesh.halfedge_handle(e, 0));
     const auto g = mesh.face_handle(mesh.halfedge_handle(e, 1));
     if (coplanar_faces(f, g)) {
-      return "not minimal: adjacent faces " + std::to_string(f.idx()) + " and " + std::to_string(g.idx()) + " are coplanar";
+      return "not minimal: adjacent faces " + std::to_string(f.idx()) + " and " +
+             std::to_string(g.idx()) + " are coplanar";
     }
   }
   for (auto v : mesh.vertices()) {
     std::vector<Mesh::FaceHandle> classes;
     for (auto f : mesh.vf_range(v)) {
-      if (std::none_of(classes.begin(), classes.end(), [&](auto g) { return coplanar_faces(g, f); })) classes.push_back(f);
+      if (std::none_of(classes.begin(), classes.end(),
+                       [&](auto g) { return coplanar_faces(g, f); }))
+        classes.push_back(f);
     }
     if (classes.size() < 3) {
-      return "not minimal: vertex " + std::to_string(v.idx()) + " has " + std::to_string(classes.size()) +
-             " distinct face planes around it";
+      return "not minimal: vertex " + std::to_string(v.idx()) + " has " +
+             std::to_string(classes.size()) + " distinct face planes around it";
     }
   }
   return {};

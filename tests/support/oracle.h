@@ -69,7 +69,8 @@ ExactSet exact_opening(const Mesh& A, const Mesh& B);
 
 /// First difference between two descriptions compared exactly (positions, facets as
 /// position sets, counts), volume to `volume_rel_tol`; empty when they agree.
-std::string compare_exact(const Description& got, const Description& want, double volume_rel_tol = 1e-12);
+std::string compare_exact(const Description& got, const Description& want,
+                          double volume_rel_tol = 1e-12);
 
 /// First difference between two convex bodies compared with tolerances: every vertex of
 /// each lies within `dist_tol` (absolute) of the other's facet planes, and volumes agree to

@@ -6,7 +6,8 @@
 
 namespace morph::test {
 
-Mesh mesh_from_polygons(const std::vector<Point>& points, const std::vector<std::vector<int>>& faces) {
+Mesh mesh_from_polygons(const std::vector<Point>& points,
+                        const std::vector<std::vector<int>>& faces) {
   Mesh mesh;
   std::vector<Mesh::VertexHandle> handles;
   handles.reserve(points.size());
@@ -14,7 +15,8 @@ Mesh mesh_from_polygons(const std::vector<Point>& points, const std::vector<std:
   for (const auto& face : faces) {
     std::vector<Mesh::VertexHandle> fv;
     for (int i : face) fv.push_back(handles.at(static_cast<std::size_t>(i)));
-    if (!mesh.add_face(fv).is_valid()) throw std::invalid_argument("mesh_from_polygons: face rejected by OpenMesh");
+    if (!mesh.add_face(fv).is_valid())
+      throw std::invalid_argument("mesh_from_polygons: face rejected by OpenMesh");
   }
   return mesh;
 }
@@ -55,7 +57,8 @@ Mesh random_sphere_polytope(int n, std::uint64_t seed, double radius) {
 Mesh random_cube_polytope(int n, std::uint64_t seed, double half) {
   Random rng(seed);
   std::vector<Point> pts;
-  for (int i = 0; i < n; ++i) pts.emplace_back(rng.uniform(-half, half), rng.uniform(-half, half), rng.uniform(-half, half));
+  for (int i = 0; i < n; ++i)
+    pts.emplace_back(rng.uniform(-half, half), rng.uniform(-half, half), rng.uniform(-half, half));
   return convex_hull_mesh(pts);
 }
 
@@ -64,7 +67,8 @@ Mesh random_integer_polytope(int n, std::uint64_t seed, int range) {
   for (;;) {
     std::vector<Point> pts;
     for (int i = 0; i < n; ++i) {
-      pts.emplace_back(rng.integer(-range, range), rng.integer(-range, range), rng.integer(-range, range));
+      pts.emplace_back(rng.integer(-range, range), rng.integer(-range, range),
+                       rng.integer(-range, range));
     }
     try {
       return convex_hull_mesh(pts);
@@ -79,7 +83,8 @@ Mesh random_grid_polytope(int n, std::uint64_t seed) {
   std::vector<Point> pts;
   for (int i = 0; i < n; ++i) {
     const Point p = rng.on_sphere(1.0);
-    pts.emplace_back(std::round(p[0] * 0x1.0p20) * 0x1.0p-20, std::round(p[1] * 0x1.0p20) * 0x1.0p-20,
+    pts.emplace_back(std::round(p[0] * 0x1.0p20) * 0x1.0p-20,
+                     std::round(p[1] * 0x1.0p20) * 0x1.0p-20,
                      std::round(p[2] * 0x1.0p20) * 0x1.0p-20);
   }
   return convex_hull_mesh(pts);
@@ -108,22 +113,29 @@ Mesh transformed(const Mesh& mesh, const std::vector<double>& m) {
   Mesh out = mesh;
   for (auto v : out.vertices()) {
     const Point p = mesh.point(v);
-    out.set_point(v, Point(m[0] * p[0] + m[1] * p[1] + m[2] * p[2], m[3] * p[0] + m[4] * p[1] + m[5] * p[2],
-                           m[6] * p[0] + m[7] * p[1] + m[8] * p[2]));
+    out.set_point(
+        v, Point(m[0] * p[0] + m[1] * p[1] + m[2] * p[2], m[3] * p[0] + m[4] * p[1] + m[5] * p[2],
+                 m[6] * p[0] + m[7] * p[1] + m[8] * p[2]));
   }
   return out;
 }
 
 Mesh box(Point lo, Point hi) {
   std::vector<Point> p;
-  for (int c = 0; c < 8; ++c) p.emplace_back(c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2]);
+  for (int c = 0; c < 8; ++c)
+    p.emplace_back(c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2]);
   // Corner c has bit 0 = x, bit 1 = y, bit 2 = z; faces counter-clockwise from outside.
-  return mesh_from_polygons(p, {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}});
+  return mesh_from_polygons(
+      p, {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}});
 }
 
-Mesh cube(double edge) { return box(Point(-edge / 2, -edge / 2, -edge / 2), Point(edge / 2, edge / 2, edge / 2)); }
+Mesh cube(double edge) {
+  return box(Point(-edge / 2, -edge / 2, -edge / 2), Point(edge / 2, edge / 2, edge / 2));
+}
 
-Mesh rotated_cube_quads(double edge, std::uint64_t seed) { return transformed(cube(edge), random_rotation(seed)); }
+Mesh rotated_cube_quads(double edge, std::uint64_t seed) {
+  return transformed(cube(edge), random_rotation(seed));
+}
 
 Mesh rotated_cube_triangles(double edge, std::uint64_t seed) {
   return convex_hull_mesh(positions(rotated_cube_quads(edge, seed)));
@@ -135,9 +147,10 @@ Mesh tetrahedron(double s) {
 }
 
 Mesh octahedron(double r) {
-  return mesh_from_polygons({Point(r, 0, 0), Point(-r, 0, 0), Point(0, r, 0), Point(0, -r, 0), Point(0, 0, r),
-                             Point(0, 0, -r)},
-                            {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}});
+  return mesh_from_polygons(
+      {Point(r, 0, 0), Point(-r, 0, 0), Point(0, r, 0), Point(0, -r, 0), Point(0, 0, r),
+       Point(0, 0, -r)},
+      {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}});
 }
 
 Mesh translated(const Mesh& mesh, Point t) {

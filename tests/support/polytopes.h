@@ -14,7 +14,8 @@
 namespace morph::test {
 
 /// A mesh from points and faces (vertex index lists, counter-clockwise seen from outside).
-Mesh mesh_from_polygons(const std::vector<Point>& points, const std::vector<std::vector<int>>& faces);
+Mesh mesh_from_polygons(const std::vector<Point>& points,
+                        const std::vector<std::vector<int>>& faces);
 
 /// The convex hull of `points`, with exactly coplanar adjacent hull triangles merged into
 /// one polygon and points that are not extreme dropped. Exactly convex and planar.
@@ -26,10 +27,10 @@ Mesh convex_hull_mesh(const std::vector<Point>& points);
 class Random {
  public:
   explicit Random(std::uint64_t seed);
-  double uniform();                        // [0, 1)
-  double uniform(double lo, double hi);    // [lo, hi)
-  int integer(int lo, int hi);             // [lo, hi]
-  Point on_sphere(double radius);          // uniform direction times radius
+  double uniform();                      // [0, 1)
+  double uniform(double lo, double hi);  // [lo, hi)
+  int integer(int lo, int hi);           // [lo, hi]
+  Point on_sphere(double radius);        // uniform direction times radius
   std::uint64_t next();
 
  private:

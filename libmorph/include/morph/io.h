@@ -5,8 +5,9 @@
 // (max_digits10), so a write-then-read round trip is bit-exact. Every malformed input
 // is an input_error naming the file and the line or element; sizes beyond ReadLimits
 // are a limit_error (readers may also throw invalid_mesh for faces that cannot form a
-// manifold mesh). Reading and writing are linear in the file size. Files are written atomically: a temporary file beside the target,
-// then a rename, so a failed write never leaves a partial file nor clobbers the target.
+// manifold mesh). Reading and writing are linear in the file size. Files are written atomically: a
+// temporary file beside the target, then a rename, so a failed write never leaves a partial file
+// nor clobbers the target.
 #pragma once
 
 #include <morph/mesh.h>
@@ -36,8 +37,8 @@ MeshFormat format_from_name(std::string_view name);
 /// checked against the size of the input, so a 60-byte file cannot claim a billion
 /// vertices and make the reader allocate gigabytes.
 struct ReadLimits {
-  std::size_t max_vertices = 50'000'000;  // per mesh
-  std::size_t max_faces = 100'000'000;    // per mesh
+  std::size_t max_vertices = 50'000'000;   // per mesh
+  std::size_t max_faces = 100'000'000;     // per mesh
   std::size_t max_face_valence = 100'000;  // vertices of one face
 };
 
@@ -71,10 +72,12 @@ struct WriteOptions {
 
 /// Writes a mesh atomically (temporary file + rename). Throws io_error when the file
 /// cannot be written; the target is then left as it was.
-void write_mesh(const Mesh& mesh, const std::filesystem::path& path, const WriteOptions& options = {});
+void write_mesh(const Mesh& mesh, const std::filesystem::path& path,
+                const WriteOptions& options = {});
 
 /// Writes a mesh to a stream in the given format (options.format is ignored).
 /// Throws io_error when the stream fails.
-void write_mesh(const Mesh& mesh, std::ostream& out, MeshFormat format, const WriteOptions& options = {});
+void write_mesh(const Mesh& mesh, std::ostream& out, MeshFormat format,
+                const WriteOptions& options = {});
 
 }  // namespace morph

@@ -41,14 +41,14 @@ enum class EmptyReason {
 
 /// The result of a morphological operation.
 struct MorphResult {
-  Mesh mesh;                         // empty (no vertices) when `empty_reason != none`
+  Mesh mesh;  // empty (no vertices) when `empty_reason != none`
   // One per face. Dilation and opening: as minkowski_sum labels them. Erosion: every facet
   // is a facet of A moved inwards by a vertex of B that supports B along its normal
   // (kind translated, a = A's facet, b = B's vertex). Closing: the label of the facet of
   // A (+) B each facet lies on (for a convex A, translated facets of A). Empty when empty.
   std::vector<FacetOrigin> origins;
   EmptyReason empty_reason = EmptyReason::none;
-  std::string message;               // why it is empty, for callers and apps to report
+  std::string message;  // why it is empty, for callers and apps to report
   bool is_empty() const { return empty_reason != EmptyReason::none; }
 };
 

@@ -30,14 +30,14 @@ Mesh make_structuring_element(std::string_view spec);
 
 /// Generators, all centred on the origin with outward-oriented faces; linear in their
 /// output size. Non-positive or non-finite sizes throw input_error.
-Mesh make_icosphere(double radius, int level);       // 20*4^level triangles
-Mesh make_uv_sphere(double radius, int n);           // n >= 3
-Mesh make_box(double x, double y, double z);         // 6 quads
+Mesh make_icosphere(double radius, int level);  // 20*4^level triangles
+Mesh make_uv_sphere(double radius, int n);      // n >= 3
+Mesh make_box(double x, double y, double z);    // 6 quads
 Mesh make_tetrahedron(double radius);
 Mesh make_octahedron(double radius);
 Mesh make_icosahedron(double radius);
-Mesh make_dodecahedron(double radius);               // 12 pentagons
+Mesh make_dodecahedron(double radius);                    // 12 pentagons
 Mesh make_cylinder(double radius, double height, int n);  // n-gon prism
-Mesh make_snub_dodecahedron(double radius);          // 80 triangles + 12 pentagons
+Mesh make_snub_dodecahedron(double radius);               // 80 triangles + 12 pentagons
 
 }  // namespace morph
