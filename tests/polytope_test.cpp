@@ -406,6 +406,60 @@ TEST_CASE("polytope: make_operand's one-pass check gives the check's verdicts") 
       bow.add_face(v[t[0]], v[t[1]], v[t[2]]);
     check_operand_agrees(bow, "bow tie");
   }
+  SUBCASE("topology: connectivity proven by smaller neighbours, or searched") {
+    // An octahedron, its vertex at +x, -x, +y, -y, +z, -z in the order `axis` gives: with -x
+    // second, vertex 1 has no neighbour of smaller index (the search decides); with +y second,
+    // every vertex but 0 has one (connected without a search).
+    const auto octahedron = [](const std::vector<int>& axis) {
+      std::vector<Point> points(6);
+      for (int a = 0; a < 6; ++a) {
+        Point q(0, 0, 0);
+        q[a / 2] = a % 2 == 0 ? 1 : -1;
+        points[axis[a]] = q;
+      }
+      std::vector<std::vector<int>> faces;
+      for (int octant = 0; octant < 8; ++octant) {
+        const int x = axis[octant & 1], y = axis[2 + (octant >> 1 & 1)],
+                  z = axis[4 + (octant >> 2 & 1)];
+        // Outward: (x, y, z) turns counter-clockwise seen from the octant when it has an even
+        // number of negative axes.
+        if (__builtin_popcount(octant) % 2 == 0)
+          faces.push_back({x, y, z});
+        else
+          faces.push_back({x, z, y});
+      }
+      return morph::test::mesh_from_polygons(points, faces);
+    };
+    check_operand_agrees(octahedron({0, 1, 2, 3, 4, 5}), "octahedron, -x second");
+    check_operand_agrees(octahedron({0, 2, 1, 3, 4, 5}), "octahedron, +y second");
+    const Polytope searched = morph::detail::make_operand(octahedron({0, 1, 2, 3, 4, 5}), "A");
+    const Polytope proven = morph::detail::make_operand(octahedron({0, 2, 1, 3, 4, 5}), "A");
+    CHECK(searched.num_faces() == 8);
+    CHECK(proven.num_faces() == 8);
+    // A tetrahedron beside a torus: V - E + F = 2 but not connected (no numbering proves it).
+    std::vector<Point> points = {{10, 0, 0}, {11, 0, 0}, {10, 1, 0}, {10, 0, 1}};
+    std::vector<std::vector<int>> faces = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) {
+        const double u = M_PI / 2 * i, v = M_PI / 2 * j;
+        points.emplace_back((3 + std::cos(v)) * std::cos(u), (3 + std::cos(v)) * std::sin(u),
+                            std::sin(v));
+        faces.push_back({4 + 4 * i + j, 4 + 4 * ((i + 1) % 4) + j,
+                         4 + 4 * ((i + 1) % 4) + (j + 1) % 4, 4 + 4 * i + (j + 1) % 4});
+      }
+    const Mesh apart = morph::test::mesh_from_polygons(points, faces);
+    CHECK(static_cast<int>(apart.n_vertices()) - static_cast<int>(apart.n_edges()) +
+              static_cast<int>(apart.n_faces()) ==
+          2);
+    check_operand_agrees(apart, "tetrahedron and torus");
+    std::string message;
+    try {
+      morph::detail::make_operand(apart, "A");
+    } catch (const std::exception& error) {
+      message = error.what();
+    }
+    CHECK(message.find("not connected") != std::string::npos);
+  }
   SUBCASE("geometry: flat, inverted, non-finite, out of range") {
     std::vector<Point> flat = cube;
     for (auto& p : flat) p[2] = 0;

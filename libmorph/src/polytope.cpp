@@ -767,14 +767,20 @@ bool is_canonical(const Polytope& p, bool edges_convex = false) {
 /// The rest of check_operand's topological checks on a mesh whose halfedges
 /// connectivity_from_halfedges found consistent (every vertex one fan reaching each
 /// neighbour once): every vertex's halfedge leaves it (where the check's fan walk starts),
-/// the vertices are connected, and V - E + F = 2.
-bool operand_topology(const Polytope& p, const HalfedgeArrays& arrays, int nf) {
+/// the vertices are connected, and V - E + F = 2. `descending`: every vertex but vertex 0 has a
+/// neighbour of smaller index (the fan walk found it), which proves them connected: steps to
+/// smaller neighbours from any vertex end at one without any, vertex 0. The usual numberings
+/// (a subdivision's, a grid's) have it; otherwise a search decides.
+bool operand_topology(const Polytope& p, const HalfedgeArrays& arrays, int nf, bool descending) {
   const int nv = p.num_vertices();
   const int nh = static_cast<int>(p.corner_vertex.size());
   for (int v = 0; v < nv; ++v) {
     const int h = arrays.halfedge_of_vertex(v);
     if (h < 0 || h >= nh || arrays.to(h ^ 1) != v) return false;
   }
+  const bool euler = static_cast<long long>(nv) - nh / 2 + nf == 2;
+  // The search's branch on each neighbour mispredicts often: skipped when connectivity is proven.
+  if (descending) return euler;
   // A search through the fans from vertex 0, as the check's. Each vertex is pushed at most
   // once: the stack needs nv slots (written before read, left uninitialised).
   std::vector<char> reached(nv, 0);
@@ -796,7 +802,7 @@ bool operand_topology(const Polytope& p, const HalfedgeArrays& arrays, int nf) {
       stack[top++] = w;
     }
   }
-  return count == nv && static_cast<long long>(nv) - nh / 2 + nf == 2;
+  return count == nv && euler;
 }
 
 /// What make_operand's checked path (checked_polytope) reads off the halfedges beside the
@@ -917,6 +923,9 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   // The checked path: the vertex whose fan last reached each vertex (a neighbour reached
   // twice means two edges between the same vertices).
   std::vector<int> seen(topology ? nv : 0, -1);
+  // The checked path: whether every vertex but vertex 0 has a smaller neighbour (see
+  // operand_topology).
+  bool descending = true;
   // The fans as build_connectivity walks them (from facet f at v, the next facet is the one
   // across f's incoming edge u -> v), read straight off the halfedges: the slot of a corner at
   // v is, as given, the halfedge g = u -> v of its face (the face, u = to(g ^ 1), the edge),
@@ -930,6 +939,7 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
       continue;
     }
     int g = first;
+    int smallest = v;  // the smallest of v and its neighbours
     do {
       if (slot == nc) throw error("internal error: a mesh vertex has a broken fan");
       fan_face[slot] = arrays.face(g);
@@ -939,14 +949,16 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
       if (topology) {
         consistent &= seen[w] != v;
         seen[w] = v;
+        smallest = std::min(smallest, w);
       }
       ++slot;
       g = reversed ? arrays.next(g ^ 1) : arrays.prev(g ^ 1);
     } while (g != first);
+    descending &= (smallest < v) | (v == 0);
   }
   p.fan_begin[nv] = slot;
   if (slot != nc) throw error("internal error: a mesh vertex has several fans");
-  if (topology && consistent) topology->passes = operand_topology(p, arrays, nf);
+  if (topology && consistent) topology->passes = operand_topology(p, arrays, nf, descending);
   return mesh_edge;
 }
 
