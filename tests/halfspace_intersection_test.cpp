@@ -17,6 +17,7 @@
 #include <optional>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "fims.h"
@@ -452,8 +453,9 @@ std::string input_difference(const ErosionInput& got, const ErosionInput& want) 
   if (got.halfspaces.size() != want.halfspaces.size()) return "half-space counts differ";
   for (std::size_t k = 0; k < got.halfspaces.size(); ++k) {
     const HalfSpace &g = got.halfspaces[k], &w = want.halfspaces[k];
-    if (!same3(g.normal, w.normal)) return "normal " + std::to_string(k) + " differs";
-    if (g.offset != w.offset || g.denominator != w.denominator)
+    if (!same3(g.exact_normal(), w.exact_normal()))
+      return "normal " + std::to_string(k) + " differs";
+    if (g.exact_offset() != w.exact_offset() || g.denominator != w.denominator)
       return "offset " + std::to_string(k) + " differs";
     if (g.source != w.source || g.element != w.element)
       return "labels of " + std::to_string(k) + " differ";
@@ -611,7 +613,8 @@ TEST_CASE("halfspace_intersection: an erosion's quadrilateral half-spaces are ex
       ++quads;
       const HalfSpace& h = in.halfspaces[f];
       const V3<ExactN>& n = A.exact_normal(f);
-      CHECK((h.normal.x == n.x && h.normal.y == n.y && h.normal.z == n.z));
+      const V3<ExactN>& hn = h.exact_normal();
+      CHECK((hn.x == n.x && hn.y == n.y && hn.z == n.z));
       std::optional<ExactN> top_a, top_b;
       for (int k = 0; k < 4; ++k) {
         const ExactN d = dot(n, to_exact_n(A.points[A.corner(f, k)]));
@@ -622,15 +625,116 @@ TEST_CASE("halfspace_intersection: an erosion's quadrilateral half-spaces are ex
         if (!top_b || d > *top_b) top_b = d;
       }
       CHECK(h.denominator == ExactN(1));
-      CHECK(h.offset == *top_a - *top_b);
+      CHECK(h.exact_offset() == *top_a - *top_b);
       for (int j = in.known.begin[f]; j < in.known.begin[f + 1]; ++j) {
         const int k = in.known.point[j];
-        CHECK(dot(n, in.known.X[k]) == h.offset * in.known.W[k]);
+        CHECK(dot(n, in.known.X[k]) == h.exact_offset() * in.known.W[k]);
       }
     }
     CHECK(quads > 0);
     const MaybePolytope r = eroded_three_ways(A, B);
     REQUIRE(r.polytope);
+  }
+}
+
+// An erosion's triangles of double points in a small frame leave their exact normal and
+// offset lazy (made from fixed-point words on first read): zero until then, and then the
+// exact values, (q - p) x (r - p) and <n, p> - max_j <n, b_j>, also when several threads
+// ask for them at once (one makes them, the others wait); the erosion reads them only where
+// a filter cannot decide (and for a polytope), with the same result as an eager copy's.
+TEST_CASE("halfspace_intersection: an erosion's lazy exact planes are the exact values") {
+  const morph::Mesh b =
+      morph::test::transformed(sample("icosphere_80.off"), morph::test::random_rotation(5));
+  // (The last is scaled near the double-double copies' range: some offsets may leave it,
+  // and are then made eagerly, with the same values.)
+  struct Case {
+    morph::Mesh a;
+    double scale;
+    bool lazy;
+  };
+  for (const Case& c :
+       {Case{sample("icosphere_320.off"), 1.0 / 8, true},
+        Case{sample("uvsphere_1600.off"), 1.0 / 32, true},
+        Case{morph::test::scaled(sample("icosphere_320.off"), 0x1p200), 0x1p197, false}}) {
+    const morph::Mesh& a = c.a;
+    const double scale = c.scale;
+    const Polytope A = make_operand(a, "A");
+    const Polytope B = make_operand(morph::test::scaled(b, scale), "B");
+    const ErosionInput in = erode_sum_input(A, A, B);
+    REQUIRE(static_cast<int>(in.halfspaces.size()) == A.num_faces());
+    // The expected values, in Mpzf.
+    std::vector<V3<ExactN>> normal(A.num_faces());
+    std::vector<ExactN> offset(A.num_faces());
+    int lazy = 0;
+    for (int f = 0; f < A.num_faces(); ++f) {
+      const HalfSpace& h = in.halfspaces[f];
+      if (A.degree(f) != 3) continue;
+      const V3<double>&p = A.points[A.corner(f, 0)], &q = A.points[A.corner(f, 1)],
+            &r = A.points[A.corner(f, 2)];
+      normal[f] = cross(to_exact_n(q) - to_exact_n(p), to_exact_n(r) - to_exact_n(p));
+      std::optional<ExactN> top_b;
+      for (const auto& v : B.points) {
+        const ExactN d = dot(normal[f], to_exact_n(v));
+        if (!top_b || d > *top_b) top_b = d;
+      }
+      offset[f] = dot(normal[f], to_exact_n(p)) - *top_b;
+      if (!h.lazy) continue;
+      ++lazy;
+      CHECK(h.has_normal_dd);
+      CHECK(h.has_offset_dd);
+      CHECK(h.denominator == ExactN(1));
+      // Not made yet (the input stage reads it only for B's edges and facets along n).
+      if (!h.made.state.load()) CHECK(CGAL::sign(h.offset) == CGAL::ZERO);
+    }
+    if (c.lazy) CHECK(lazy > 0);
+    // Copies, so that nothing is made yet where the input did not make it: four threads
+    // read them all at once, in different orders.
+    const std::vector<HalfSpace> hs = in.halfspaces;
+    constexpr int kThreads = 4;
+    std::vector<std::vector<char>> same(kThreads, std::vector<char>(hs.size(), 0));
+    {
+      std::vector<std::thread> threads;
+      for (int t = 0; t < kThreads; ++t)
+        threads.emplace_back([&, t] {
+          const int n = static_cast<int>(hs.size());
+          for (int k = 0; k < n; ++k) {
+            const int f = t % 2 == 0 ? k : n - 1 - k;
+            const V3<ExactN>& m = hs[f].exact_normal();
+            same[t][f] =
+                A.degree(f) != 3 || (m.x == normal[f].x && m.y == normal[f].y &&
+                                     m.z == normal[f].z && hs[f].exact_offset() == offset[f]);
+          }
+        });
+      for (std::thread& t : threads) t.join();
+    }
+    for (int t = 0; t < kThreads; ++t)
+      CHECK(std::count(same[t].begin(), same[t].end(), 1) == static_cast<long>(hs.size()));
+    // The intersection of lazy half-spaces (an opening's polytope reads every normal) is the
+    // one of their eager copies.
+    std::vector<HalfSpace> eager = in.halfspaces;
+    for (HalfSpace& h : eager) {
+      h.exact_normal();
+      h.lazy = false;
+    }
+    for (const bool guess : {true, false}) {
+      IntersectOptions options;
+      options.guess = guess;
+      const MaybePolytope x =
+          intersect_halfspaces(in.halfspaces, in.hint, options, in.known, in.expected);
+      const MaybePolytope y = intersect_halfspaces(eager, in.hint, options, in.known, in.expected);
+      REQUIRE(x.polytope);
+      REQUIRE(y.polytope);
+      REQUIRE(x.rounded.points.size() == y.rounded.points.size());
+      for (std::size_t k = 0; k < x.rounded.points.size(); ++k) {
+        const V3<double>&u = x.rounded.points[k], &v = y.rounded.points[k];
+        CHECK((u.x == v.x && u.y == v.y && u.z == v.z));
+      }
+      CHECK(x.rounded.corner_vertex == y.rounded.corner_vertex);
+      for (int f = 0; f < x.polytope->num_faces(); ++f) {
+        const V3<ExactN>&u = x.polytope->exact_normal(f), &v = y.polytope->exact_normal(f);
+        CHECK((u.x == v.x && u.y == v.y && u.z == v.z));
+      }
+    }
   }
 }
 

@@ -185,6 +185,12 @@ KnownPoints erosion_points(const Polytope& A, const Polytope& B,
 
 }  // namespace
 
+void HalfSpace::set_exact_from_words(const HalfSpace& h) {
+  const ExactWords& w = h.words;
+  fixed::set_exact(V3<fixed::i128>{w.n[0], w.n[1], w.n[2]}, w.normal_exp, h.normal);
+  fixed::set_exact(fixed::Int<3>{{w.d[0], w.d[1], w.d[2]}}, w.offset_exp, h.offset);
+}
+
 namespace {
 
 ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b,
@@ -207,11 +213,36 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
       h.source = A.face_source[f];
       h.element = B.vertex_source[b];
       // For a normal of double differences and an element of double points: another
-      // candidate c attains h_B iff <n, c - b> = 0.
-      const auto add_others_on_plane = [&](const V3<ExactN>& normal) {
+      // candidate c attains h_B iff <n, c - b> = 0 (the exact normal made here when lazy and
+      // there is another: B's edge or facet along it, rare).
+      const auto add_others_on_plane = [&]() {
         for (int c : candidates)
-          if (c != b && CGAL::sign(dot(normal, exact_difference(B.points[c], B.points[b]))) == 0)
+          if (c != b &&
+              CGAL::sign(dot(h.exact_normal(), exact_difference(B.points[c], B.points[b]))) == 0)
             others[f].push_back(c);
+      };
+      // A fixed-point plane (wide_exact.h) with the offset <n, top - pb>: in a small frame,
+      // when both double-double copies are made, its exact values are left lazy (their words
+      // kept: most are never read, the filters and the precise stage taking the copies);
+      // otherwise made Mpzf now. The same values either way.
+      const auto set_fixed = [&](const fixed::Normal& n, const V3<double>& top,
+                                 const V3<double>& pb) {
+        h.has_normal_dd = n.normal_dd(0, h.normal_dd);
+        ExactWords& w = h.words;
+        V3<fixed::i128> normal;
+        fixed::Int<3> offset;
+        if (h.has_normal_dd &&
+            n.small_words(0, top, pb, normal, w.normal_exp, offset, w.offset_exp)) {
+          CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+          if (fixed::to_dd(offset, w.offset_exp, h.offset_dd)) {
+            w.n = {normal.x, normal.y, normal.z};
+            w.d = {offset.w[0], offset.w[1], offset.w[2]};
+            h.has_offset_dd = h.lazy = true;
+            return;
+          }
+        }
+        n.set_normal(0, h.normal);  // hs's are new: zero
+        h.has_offset_dd = n.set_dot(0, top, &pb, h.offset, &h.offset_dd);
       };
       if (A.degree(f) == 3 && A.given_normals.empty() && B.exact_points.empty()) {
         // A triangle of double points (A's are then all doubles) and an element of double
@@ -227,16 +258,14 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
         const fixed::Frame frame{p.x, p.y, p.z, q.x, q.y, q.z, r.x, r.y, r.z, pb.x, pb.y, pb.z};
         if (frame.ok) {
           const fixed::Normal n(frame, p, q, p, r);
-          n.set_normal(0, h.normal);  // hs's are new: zero
-          h.has_offset_dd = n.set_dot(0, p, &pb, h.offset, &h.offset_dd);
-          h.has_normal_dd = n.normal_dd(0, h.normal_dd);
+          set_fixed(n, p, pb);
           if (!h.has_normal_dd) set_normal_dd(h, p, q, r);
         } else {
           set_normal_dd(h, p, q, r);
           h.normal = triangle_normal(A, f);
           h.offset = dot(h.normal, exact_difference(p, pb));
         }
-        add_others_on_plane(h.normal);
+        add_others_on_plane();
         continue;
       }
       if (A.degree(f) == 4 && A.given_normals.empty() && A.exact_points.empty() &&
@@ -264,10 +293,8 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
         if (frame.ok) {
           const fixed::Normal n(frame, p0, p2, p1, p3);
           const int top = set_top(n.sign_dot(p1, p0));
-          n.set_normal(0, h.normal);  // hs's are new: zero
-          h.has_offset_dd = n.set_dot(0, top == 1 ? p1 : p0, &pb, h.offset, &h.offset_dd);
-          h.has_normal_dd = n.normal_dd(0, h.normal_dd);
-          add_others_on_plane(h.normal);
+          set_fixed(n, top == 1 ? p1 : p0, pb);
+          add_others_on_plane();
           continue;
         }
         h.normal = cross(exact_difference(corner(2), corner(0)),
@@ -282,7 +309,7 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
         if (sign == 2) sign = CGAL::sign(dot(h.normal, exact_difference(corner(1), corner(0))));
         const int top = set_top(sign);
         h.offset = dot(h.normal, exact_difference(corner(top), B.points[b]));
-        add_others_on_plane(h.normal);
+        add_others_on_plane();
         continue;
       }
       const V3<ExactN> n =

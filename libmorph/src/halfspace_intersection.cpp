@@ -76,8 +76,18 @@ struct ExactPlane {
 /// at the HalfSpace's normal and offset when its denominator is 1 (the usual case: no Mpzf
 /// copied per plane, where the filters decide nearly everything), else at `scaled`.
 struct Plane {
-  const V3<ExactN>* n = nullptr;
-  const ExactN* d = nullptr;
+  // The exact normal and offset (read through n() and d(): a lazy half-space's are made on
+  // first read, HalfSpace::make_exact).
+  const V3<ExactN>* n_exact = nullptr;
+  const ExactN* d_exact = nullptr;
+  const V3<ExactN>& n() const {
+    if (source) source->make_exact();
+    return *n_exact;
+  }
+  const ExactN& d() const {
+    if (source) source->make_exact();
+    return *d_exact;
+  }
   std::shared_ptr<const ExactPlane> scaled;
   V3<Interval> ni;
   Interval di;
@@ -164,14 +174,14 @@ std::vector<Plane> planes_of(const std::vector<HalfSpace>& hs) {
       Plane& p = planes[i];
       const ExactN& q = hs[i].denominator;
       if (q == 1) {
-        p.n = &hs[i].normal;
-        p.d = &hs[i].offset;
+        p.n_exact = &hs[i].normal;
+        p.d_exact = &hs[i].offset;
       } else {
         // (The offset is the numerator: the plane is the HalfSpace times q.)
         p.scaled = std::make_shared<const ExactPlane>(
             ExactPlane{{hs[i].normal.x * q, hs[i].normal.y * q, hs[i].normal.z * q}, hs[i].offset});
-        p.n = &p.scaled->n;
-        p.d = &p.scaled->d;
+        p.n_exact = &p.scaled->n;
+        p.d_exact = &p.scaled->d;
       }
       if (q == 1 && (hs[i].has_normal_dd || hs[i].has_offset_dd)) p.source = &hs[i];
       if (q == 1 && hs[i].has_normal_dd) {
@@ -179,17 +189,17 @@ std::vector<Plane> planes_of(const std::vector<HalfSpace>& hs) {
         const auto& c = hs[i].normal_dd;
         p.ni = {neighbours_interval(c[0]), neighbours_interval(c[1]), neighbours_interval(c[2])};
       } else {
-        p.ni = to_interval_n(*p.n);
+        p.ni = to_interval_n(p.n());
       }
       p.di = q == 1 && hs[i].has_offset_dd ? neighbours_interval(hs[i].offset_dd)
-                                           : to_interval_n(*p.d);
+                                           : to_interval_n(p.d());
       set_doubles(p);
     }
   });
   return planes;
 }
 
-Exact rational_offset(const HalfSpace& h) { return Exact(h.offset) / Exact(h.denominator); }
+Exact rational_offset(const HalfSpace& h) { return Exact(h.exact_offset()) / Exact(h.denominator); }
 
 /// Chebyshev-like centre for the L1 norm: maximise t subject to
 /// <n_i, x> + |n_i|_1 t <= d_i, t <= 1. t* > 0: a solid (x* strictly inside);
@@ -202,7 +212,7 @@ CentreResult exact_centre(const std::vector<HalfSpace>& hs) {
   using Program = CGAL::Quadratic_program<Exact>;
   Program lp(CGAL::SMALLER, false, 0, false, 0);
   for (int i = 0; i < static_cast<int>(hs.size()); ++i) {
-    const V3<Exact> n = to_rational(hs[i].normal);
+    const V3<Exact> n = to_rational(hs[i].exact_normal());
     lp.set_a(0, i, n.x);
     lp.set_a(1, i, n.y);
     lp.set_a(2, i, n.z);
@@ -229,7 +239,7 @@ bool strictly_inside(const std::vector<Plane>& planes, const V3<double>& o) {
     const V3<ExactN> oe = to_exact_n(o);
     for (int i = begin; i < end && inside; ++i) {
       int s = interval_sign(planes[i].di - dot(planes[i].ni, oi));
-      if (s == 2) s = CGAL::sign(*planes[i].d - dot(*planes[i].n, oe));
+      if (s == 2) s = CGAL::sign(planes[i].d() - dot(planes[i].n(), oe));
       if (s <= 0) inside = false;
     }
   });
@@ -480,7 +490,7 @@ void make_exact(const std::vector<Plane>& planes, HVertex& v) {
   if (v.X) return;
   const Plane &a = planes[v.planes[0]], &b = planes[v.planes[1]], &c = planes[v.planes[2]];
   v.made = std::make_unique<ExactCoordinates>();
-  meet(*a.n, *a.d, *b.n, *b.d, *c.n, *c.d, v.made->X, v.made->W);
+  meet(a.n(), a.d(), b.n(), b.d(), c.n(), c.d(), v.made->X, v.made->W);
   v.X = &v.made->X;
   v.W = &v.made->W;
 }
@@ -583,8 +593,10 @@ struct PrecisePlane {
 PrecisePlane precise_plane(const Plane& plane) {
   PrecisePlane p;
   const HalfSpace* h = plane.source;
-  p.valid = precise_scaled({&plane.n->x, &plane.n->y, &plane.n->z, plane.d}, 0, 3, p.c,
-                           h && h->has_normal_dd ? &h->normal_dd : nullptr,
+  // (A lazy half-space has both copies: its exact values are not read here.)
+  if (h && !(h->has_normal_dd && h->has_offset_dd)) h->make_exact();
+  p.valid = precise_scaled({&plane.n_exact->x, &plane.n_exact->y, &plane.n_exact->z, plane.d_exact},
+                           0, 3, p.c, h && h->has_normal_dd ? &h->normal_dd : nullptr,
                            h && h->has_offset_dd ? &h->offset_dd : nullptr);
   return p;
 }
@@ -618,43 +630,20 @@ V3<Magnitude> normal_magnitude(const PrecisePlane& p) { return magnitude(normal_
 }
 
 /// One-time initialisations by index: call(i, f) runs f once for each i, in whichever thread
-/// asks first, the others waiting for it. std::call_once makes a futex system call each time
-/// it runs f (glibc wakes waiters unconditionally), which cost more than most of what it
-/// guarded (a plane's precise copy, a vertex's exact coordinates).
+/// asks first, the others waiting for it (run_once's atomic claim, halfspace_intersection.h).
 class OnceFlags {
  public:
   explicit OnceFlags(std::size_t n) : state_(std::make_unique<std::atomic<unsigned char>[]>(n)) {}
   template <class F>
   void call(std::size_t i, const F& f) const {
-    if (state_[i].load(std::memory_order_acquire) != kDone) run(i, f);
+    if (state_[i].load(std::memory_order_acquire) != once_state::kDone) run_once(state_[i], f);
   }
   /// Whether f has run for i already.
-  bool done(std::size_t i) const { return state_[i].load(std::memory_order_acquire) == kDone; }
+  bool done(std::size_t i) const {
+    return state_[i].load(std::memory_order_acquire) == once_state::kDone;
+  }
 
  private:
-  static constexpr unsigned char kNone = 0, kRunning = 1, kDone = 2;
-  // A claim whose run throws (out of memory) is given back before the exception leaves: a
-  // thread waiting for it then claims it in turn (and runs f, or meets the error itself)
-  // instead of waiting forever for a value nobody is making. (run is not inlined, which
-  // keeps call small enough to inline.)
-  template <class F>
-  [[gnu::noinline]] void run(std::size_t i, const F& f) const {
-    for (;;) {
-      unsigned char expected = kNone;
-      if (state_[i].compare_exchange_strong(expected, kRunning, std::memory_order_acquire)) {
-        try {
-          f();
-        } catch (...) {
-          state_[i].store(kNone, std::memory_order_release);
-          throw;
-        }
-        state_[i].store(kDone, std::memory_order_release);
-        return;
-      }
-      if (expected == kDone) return;
-      std::this_thread::yield();
-    }
-  }
   std::unique_ptr<std::atomic<unsigned char>[]> state_;  // value-initialised: kNone
 };
 
@@ -836,7 +825,7 @@ int side_filter(const std::vector<Plane>& planes, const PrecisePlanes& precise, 
   return t != 2 || !stage ? t : precise_sign();
 }
 int side_exact(const Plane& p, const HVertex& v) {
-  return CGAL::sign(dot(*p.n, *v.X) - *p.d * *v.W);
+  return CGAL::sign(dot(p.n(), *v.X) - p.d() * *v.W);
 }
 
 /// Sign of <n, x> - d for plane i at a vertex: the double filter, then the precise stage
@@ -900,7 +889,7 @@ int compare_filter(const std::vector<Plane>& planes, const PrecisePlanes& precis
   return t != 2 || !stage ? t : precise_sign();
 }
 int compare_exact(const Plane& p, const HVertex& u, const HVertex& v) {
-  return CGAL::sign(dot(*p.n, *u.X) * *v.W - dot(*p.n, *v.X) * *u.W);
+  return CGAL::sign(dot(p.n(), *u.X) * *v.W - dot(p.n(), *v.X) * *u.W);
 }
 
 /// Exact vertex coordinates made on first use, by whichever thread needs them first (each
@@ -1000,7 +989,7 @@ double step_away(double r, bool away) {
 
 int det_sign(const Plane& a, const Plane& b, const Plane& c) {
   const int s = interval_sign(det(a.ni, b.ni, c.ni));
-  return s != 2 ? s : CGAL::sign(det(*a.n, *b.n, *c.n));
+  return s != 2 ? s : CGAL::sign(det(a.n(), b.n(), c.n()));
 }
 
 /// Sign of det(n_a, n_b, n_c) from the precise stage, or 2 (round-to-nearest; valid planes):
@@ -1027,7 +1016,7 @@ int det_sign(const std::vector<Plane>& planes, const PrecisePlanes& precise, int
     const int t = x.valid && y.valid && z.valid ? precise_det_sign(x, y, z) : 2;
     if (t != 2) return t;
   }
-  return CGAL::sign(det(*pa.n, *pb.n, *pc.n));
+  return CGAL::sign(det(pa.n(), pb.n(), pc.n()));
 }
 
 }  // namespace
@@ -1132,12 +1121,12 @@ class VertexExactPoints final : public LazyExactPoints {
     for (const HVertex& v : vertex_) {
       if (v.X) continue;
       for (int i : v.planes) {
-        if (planes_[i].n) continue;
+        if (planes_[i].n_exact) continue;
         const Plane& p = planes[i];
         planes_[i].scaled =
-            p.scaled ? p.scaled : std::make_shared<const ExactPlane>(ExactPlane{*p.n, *p.d});
-        planes_[i].n = &planes_[i].scaled->n;
-        planes_[i].d = &planes_[i].scaled->d;
+            p.scaled ? p.scaled : std::make_shared<const ExactPlane>(ExactPlane{p.n(), p.d()});
+        planes_[i].n_exact = &planes_[i].scaled->n;
+        planes_[i].d_exact = &planes_[i].scaled->d;
       }
     }
   }
@@ -1525,7 +1514,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   // strictly inside or outside every other one.
   {
     const auto& c0 = s.corner[0];
-    const V3<ExactN> r = *planes[c0[0]].n + *planes[c0[1]].n + *planes[c0[2]].n;
+    const V3<ExactN> r = planes[c0[0]].n() + planes[c0[1]].n() + planes[c0[2]].n();
     // A triangle whose three normals lie strictly on one side of a plane through o that
     // holds r or leaves it on the other side (<g, n> > 0 for all three, <g, r> <= 0) is
     // missed without its determinants: its cone holds no such r, so one of them would be
@@ -2010,7 +1999,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       RoundingGuard guard;
       for (int r : cyc) make_intervals(planes, vertex[r]);
     }
-    if (clockwise(cyc, vertex, hs[face_halfspace[0]].normal, exact_vertex))
+    if (clockwise(cyc, vertex, hs[face_halfspace[0]].exact_normal(), exact_vertex))
       for (int f = 0; f < nf; ++f)
         std::reverse(face_vertex.begin() + face_begin[f], face_vertex.begin() + face_begin[f + 1]);
   }
@@ -2067,7 +2056,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   }
   if (with_polytope) {
     std::vector<V3<ExactN>> normals(nf);
-    for (int f = 0; f < nf; ++f) normals[f] = hs[face_halfspace[f]].normal;
+    for (int f = 0; f < nf; ++f) normals[f] = hs[face_halfspace[f]].exact_normal();
     ExactPoints points = polytope_points(planes, vertex, order, options.eager_exact, owner);
     Polytope p;
     if (options.direct_polytope) {
@@ -2111,8 +2100,8 @@ class IncrementalHull {
       const ExactN d = dot(m, to_exact_n(o)) + ExactN(reach);
       Plane& v = virtual_[k];
       v.scaled = std::make_shared<const ExactPlane>(ExactPlane{m, d});
-      v.n = &v.scaled->n;
-      v.d = &v.scaled->d;
+      v.n_exact = &v.scaled->n;
+      v.d_exact = &v.scaled->d;
       v.ni = to_interval_n(m);
       v.di = to_interval_n(d);
     }
@@ -2223,7 +2212,7 @@ class IncrementalHull {
       const int k = tri.known;
       if (p < n_ && known_.passes(p, k)) return 0;
       const int s = interval_sign(dot(h.ni, known_.Xi[k]) - h.di * known_.Wi[k]);
-      return s != 2 ? s : CGAL::sign(dot(*h.n, known_.X[k]) - *h.d * known_.W[k]);
+      return s != 2 ? s : CGAL::sign(dot(h.n(), known_.X[k]) - h.d() * known_.W[k]);
     }
     const int s = interval_sign(dot(h.ni, tri.Xi) - h.di * tri.Wi);
     if (s != 2) return s;
@@ -2251,11 +2240,11 @@ class IncrementalHull {
     if (tri.exact < 0) {
       const Plane &a = plane(tri.c[0]), &b = plane(tri.c[1]), &c = plane(tri.c[2]);
       ExactVertex& v = exact_.emplace_back();
-      meet(*a.n, *a.d, *b.n, *b.d, *c.n, *c.d, v.X, v.W);
+      meet(a.n(), a.d(), b.n(), b.d(), c.n(), c.d(), v.X, v.W);
       tri.exact = static_cast<int>(exact_.size()) - 1;
     }
     const ExactVertex& v = exact_[tri.exact];
-    return CGAL::sign(dot(*h.n, v.X) - *h.d * v.W);
+    return CGAL::sign(dot(h.n(), v.X) - h.d() * v.W);
   }
 
   void see(int p, int t) {
@@ -2397,8 +2386,8 @@ class IncrementalHull {
 double first_reach(const std::vector<Plane>& planes, const V3<double>& o) {
   double r = 0;
   for (const Plane& p : planes) {
-    const V3<double> n{p.n->x.to_double(), p.n->y.to_double(), p.n->z.to_double()};
-    const double dist = (p.d->to_double() - dot(n, o)) / std::sqrt(dot(n, n));
+    const V3<double> n{p.n().x.to_double(), p.n().y.to_double(), p.n().z.to_double()};
+    const double dist = (p.d().to_double() - dot(n, o)) / std::sqrt(dot(n, n));
     if (std::isfinite(dist)) r = std::max(r, dist);
   }
   return std::ldexp(1.0, std::ilogb(std::max(r, 1e-300)) + 4);
@@ -2420,8 +2409,8 @@ DualSurface exact_dual_hull(const std::vector<Plane>& planes, const V3<Exact>& o
   std::map<Point, int> index_of;
   for (int i = 0; i < n; ++i) {
     const Plane& h = planes[i];
-    const ExactN w = qn * *h.d - dot(*h.n, p);
-    points[i] = Point(FT(Q(qn * h.n->x, w)), FT(Q(qn * h.n->y, w)), FT(Q(qn * h.n->z, w)));
+    const ExactN w = qn * h.d() - dot(h.n(), p);
+    points[i] = Point(FT(Q(qn * h.n().x, w)), FT(Q(qn * h.n().y, w)), FT(Q(qn * h.n().z, w)));
     index_of.emplace(points[i], i);
   }
   CGAL::Surface_mesh<Point> hull;
@@ -2541,7 +2530,12 @@ void set_normal_dd(HalfSpace& h, const V3<double>& p0, const V3<double>& p1, con
 }
 
 HalfSpace make_halfspace(const V3<ExactN>& normal, const Exact& offset, int source) {
-  return {normal, integer_n(offset.numerator()), integer_n(offset.denominator()), source};
+  HalfSpace h;
+  h.normal = normal;
+  h.offset = integer_n(offset.numerator());
+  h.denominator = integer_n(offset.denominator());
+  h.source = source;
+  return h;
 }
 
 namespace {

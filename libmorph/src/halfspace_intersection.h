@@ -6,9 +6,12 @@
 #include <morph/morphology.h>
 
 #include <array>
+#include <atomic>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 
 #include "polytope.h"
 
@@ -20,9 +23,61 @@ struct SumFacets;  // fims.h
 /// (polytopes with double or dyadic points) have denominator 1; a rational offset p/q is
 /// stored as offset p, denominator q (not necessarily reduced). `source` and `element` are carried
 /// to the facets of the result for their labels.
+/// Runs f once for a flag (kNone, kRunning, kDone), in whichever thread asks first, the others
+/// waiting for it: an atomic claim. std::call_once makes a futex system call each time it runs
+/// f (glibc wakes waiters unconditionally), which cost more than most of what it guards. A
+/// claim whose f throws (out of memory) is given back before the exception leaves: a thread
+/// waiting for it then claims it in turn instead of waiting forever.
+namespace once_state {
+constexpr unsigned char kNone = 0, kRunning = 1, kDone = 2;
+}
+template <class F>
+[[gnu::noinline]] void run_once(std::atomic<unsigned char>& state, const F& f) {
+  for (;;) {
+    unsigned char expected = once_state::kNone;
+    if (state.compare_exchange_strong(expected, once_state::kRunning, std::memory_order_acquire)) {
+      try {
+        f();
+      } catch (...) {
+        state.store(once_state::kNone, std::memory_order_release);
+        throw;
+      }
+      state.store(once_state::kDone, std::memory_order_release);
+      return;
+    }
+    if (expected == once_state::kDone) return;
+    std::this_thread::yield();
+  }
+}
+
+/// An erosion's exact normal and offset as the fixed-point words they come from
+/// (wide_exact.h's small frame): normal 2^normal_exp n, offset 2^offset_exp d, for n below
+/// 2^126 per component and d a 192-bit two's complement integer, least significant word first.
+/// Most of an intersection's exact planes are never read (the filters decide on the
+/// double-double copies): these become Mpzf on first need (HalfSpace::make_exact).
+struct ExactWords {
+  std::array<__int128, 3> n{};
+  std::array<std::uint64_t, 3> d{};
+  int normal_exp = 0;
+  int offset_exp = 0;
+};
+
+/// A once-flag that a copy of its owner copies (copied only while no thread sets it).
+struct OnceFlag {
+  std::atomic<unsigned char> state{once_state::kNone};
+  OnceFlag() = default;
+  OnceFlag(const OnceFlag& o) : state(o.state.load(std::memory_order_acquire)) {}
+  OnceFlag& operator=(const OnceFlag& o) {
+    state.store(o.state.load(std::memory_order_acquire), std::memory_order_release);
+    return *this;
+  }
+};
+
 struct HalfSpace {
-  V3<ExactN> normal;  // dyadic: a facet normal of a polytope; becomes the result facet's normal
-  ExactN offset;
+  // dyadic: a facet normal of a polytope; becomes the result facet's normal. Read through
+  // exact_normal() and exact_offset(): when `lazy`, both are zero until made from `words`.
+  mutable V3<ExactN> normal;
+  mutable ExactN offset;
   ExactN denominator = ExactN(1);  // positive
   int source = -1;                 // erosion: the facet of A (its label)
   int element = -1;                // erosion: the vertex of B that moved it inwards (its label)
@@ -37,6 +92,29 @@ struct HalfSpace {
   // converting the Mpzf (an erosion makes it from the same fixed-point words).
   DD offset_dd{};
   bool has_offset_dd = false;
+  // Lazy exact values (an erosion's fixed-point planes, which then have both double-double
+  // copies and denominator 1): normal and offset are made from `words` on first read, by
+  // whichever thread reads first (the values do not depend on it, so neither does any
+  // decision).
+  bool lazy = false;
+  ExactWords words{};
+  mutable OnceFlag made;
+
+  /// Makes normal and offset from `words` when lazy, once (any thread).
+  void make_exact() const {
+    if (lazy && made.state.load(std::memory_order_acquire) != once_state::kDone)
+      run_once(made.state, [this] { set_exact_from_words(*this); });
+  }
+  const V3<ExactN>& exact_normal() const {
+    make_exact();
+    return normal;
+  }
+  const ExactN& exact_offset() const {
+    make_exact();
+    return offset;
+  }
+  /// (erosion.cpp: the words made Mpzf into normal and offset, zero before.)
+  static void set_exact_from_words(const HalfSpace& h);
 };
 
 /// Sets h.normal_dd from h.normal = (p1 - p0) x (p2 - p0) for a triangle of double points

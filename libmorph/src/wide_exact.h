@@ -402,6 +402,18 @@ class Normal {
     }
     return true;
   }
+  /// For a small frame: the words of n and of <n, u - v> with their exponents, the values
+  /// that set_normal(doubling) and set_dot(doubling, u, &v) make Mpzf (set_exact makes them
+  /// later, where needed). False for a large frame.
+  bool small_words(int doubling, const V3<double>& u, const V3<double>& v, V3<i128>& normal,
+                   int& normal_exp, Int<3>& dot_value, int& dot_exp) const {
+    if (!frame_.small) return false;
+    normal = small_;
+    normal_exp = 2 * frame_.unit + doubling;
+    dot_value = dot(small_, small(u) - small(v));
+    dot_exp = 3 * frame_.unit + doubling;
+    return true;
+  }
   /// Sets `out` (default-constructed: zero) to 2^doubling <n, u - v>, or <n, u> when v is null;
   /// and `dd`, when not null, to its double-double copy from the same words (to_dd: within
   /// 2^-103 of |hi|), returning whether to_dd made one (else `dd` is unchanged).
