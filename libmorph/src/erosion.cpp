@@ -297,8 +297,8 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
           add_others_on_plane();
           continue;
         }
-        h.normal = cross(exact_difference(corner(2), corner(0)),
-                         exact_difference(corner(3), corner(1)));
+        h.normal =
+            cross(exact_difference(corner(2), corner(0)), exact_difference(corner(3), corner(1)));
         // The sign of h by intervals, exact when they cannot tell.
         int sign;
         {

@@ -19,18 +19,16 @@ namespace morph::detail {
 
 struct SumFacets;  // fims.h
 
-/// A closed half-space { x : <normal, x> <= offset / denominator }, exact. Dyadic offsets
-/// (polytopes with double or dyadic points) have denominator 1; a rational offset p/q is
-/// stored as offset p, denominator q (not necessarily reduced). `source` and `element` are carried
-/// to the facets of the result for their labels.
+// The states of a once-flag (run_once).
+namespace once_state {
+constexpr unsigned char kNone = 0, kRunning = 1, kDone = 2;
+}
+
 /// Runs f once for a flag (kNone, kRunning, kDone), in whichever thread asks first, the others
 /// waiting for it: an atomic claim. std::call_once makes a futex system call each time it runs
 /// f (glibc wakes waiters unconditionally), which cost more than most of what it guards. A
 /// claim whose f throws (out of memory) is given back before the exception leaves: a thread
 /// waiting for it then claims it in turn instead of waiting forever.
-namespace once_state {
-constexpr unsigned char kNone = 0, kRunning = 1, kDone = 2;
-}
 template <class F>
 [[gnu::noinline]] void run_once(std::atomic<unsigned char>& state, const F& f) {
   for (;;) {
@@ -73,6 +71,10 @@ struct OnceFlag {
   }
 };
 
+/// A closed half-space { x : <normal, x> <= offset / denominator }, exact. Dyadic offsets
+/// (polytopes with double or dyadic points) have denominator 1; a rational offset p/q is
+/// stored as offset p, denominator q (not necessarily reduced). `source` and `element` are carried
+/// to the facets of the result for their labels.
 struct HalfSpace {
   // dyadic: a facet normal of a polytope; becomes the result facet's normal. Read through
   // exact_normal() and exact_offset(): when `lazy`, both are zero until made from `words`.
@@ -120,8 +122,7 @@ struct HalfSpace {
 /// Sets h.normal_dd from h.normal = (p1 - p0) x (p2 - p0) for a triangle of double points
 /// (its Newell normal), when the differences are exact in doubles and the products and the
 /// bound allow; leaves h unchanged otherwise.
-void set_normal_dd(HalfSpace& h, const V3<double>& p0, const V3<double>& p1,
-                   const V3<double>& p2);
+void set_normal_dd(HalfSpace& h, const V3<double>& p0, const V3<double>& p1, const V3<double>& p2);
 
 /// The half-space <normal, x> <= offset for any rational offset.
 HalfSpace make_halfspace(const V3<ExactN>& normal, const Exact& offset, int source);

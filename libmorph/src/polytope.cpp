@@ -245,8 +245,7 @@ UnitNormal unit_newell(const std::vector<V3<double>>& points, const int* corners
   const double length = std::sqrt((nx * nx + ny * ny) + nz * nz);
   UnitNormal u;
   if (centroid_unit_normal(nx, ny, nz, length, 1.0 / length, magnitude, d, u)) return u;
-  return normalised({nx, ny, nz},
-                    ((d + 4) * kUlp * 1.01 * magnitude + 3 * d * 0x1p-1000) * 1.01);
+  return normalised({nx, ny, nz}, ((d + 4) * kUlp * 1.01 * magnitude + 3 * d * 0x1p-1000) * 1.01);
 }
 
 /// The unit normal of an interval enclosure n of a facet's Newell normal: its midpoint m,
@@ -1306,8 +1305,7 @@ std::optional<Polytope> checked_polytope(const Mesh& mesh, const char* name) {
     if (!walked) return std::nullopt;
     const FaceCycleView cycles{p.face_begin.data(), p.corner_vertex.data(), topology.across.data()};
     p.unit_normals.resize(p.num_faces());
-    passes =
-        geometry_passes(mesh, cycles, p.unit_normals.data(), units_known, edges_convex, &box);
+    passes = geometry_passes(mesh, cycles, p.unit_normals.data(), units_known, edges_convex, &box);
     rejected = !passes;
     build();
   }
