@@ -51,6 +51,7 @@ struct FacetBuffer {
   std::vector<std::pair<int, int>> pairs;  // scratch
   std::vector<Arc> x_arcs, y_arcs;         // scratch
   std::vector<int> halves;                 // scratch
+  std::vector<int> starts;                 // scratch: the chunk's walk starts (WalkStarts)
 
   void add(const FacetOrigin& origin) {
     for (const auto& [i, j] : pairs) corners.push_back(pair_key(i, j));
@@ -468,12 +469,18 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
       const bool translated = P == &A;
       SlotCache* const slots = caps_q ? &q_slots->local() : nullptr;
       const ArcPlane* const planes = q_planes->data();  // null: each formed as it is tested
+      // The chunk's starts first, in a loop of their own: each scan reads scattered normals
+      // and points of Q, and, with no walk between them, the scans' cache misses overlap.
+      if (starts) {
+        out.starts.resize(end - begin);
+        for (int f = begin; f < end; ++f) out.starts[f - begin] = (*starts)(f);
+      }
       // Whether the previous walk ended where it started: then this one likely does too (a
       // fine map walked on a coarse one: runs of facets in one region), and its first region
       // test costs less than locate's step in doubles would.
       bool stayed = false;
       for (int f = begin; f < end; ++f) {
-        const int start = starts ? (*starts)(f) : -1;
+        const int start = starts ? out.starts[f - begin] : -1;
         if (start >= 0) hint = start;
         const bool step = start < 0 && !stayed;
         const NormalRef n{P, f};
