@@ -1,14 +1,10 @@
 // The FIMS kernel (minkowski_sum.h) against the independent oracle: CGAL's exact convex
 // hull of all vertex sums (support/oracle.h), plus analytic cases.
-#include "support/oracle.h"
-#include "support/polytopes.h"
-
+#include <doctest/doctest.h>
 #include <morph/io.h>
 #include <morph/minkowski_sum.h>
 #include <morph/structuring_element.h>
 #include <morph/validate.h>
-
-#include <doctest/doctest.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -17,6 +13,9 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include "support/oracle.h"
+#include "support/polytopes.h"
 
 namespace {
 
@@ -64,7 +63,8 @@ bool valid_element(const Mesh& m, const Element& e) {
   return false;
 }
 
-std::set<Position> sums_of(const Mesh& A, const std::vector<int>& va, const Mesh& B, const std::vector<int>& vb) {
+std::set<Position> sums_of(const Mesh& A, const std::vector<int>& va, const Mesh& B,
+                           const std::vector<int>& vb) {
   std::set<Position> out;
   for (int i : va) {
     for (int j : vb) {
@@ -80,22 +80,27 @@ std::set<Position> sums_of(const Mesh& A, const std::vector<int>& va, const Mesh
 // for a facet + vertex, an edge + edge parallelogram or a vertex + facet corner).
 // With `exact_facets` false (the exact sum has sub-resolution features the library
 // merges), only the kinds and elements are checked.
-std::string origins_problem(const LabelledMesh& S, const Mesh& A, const Mesh& B, bool exact_facets) {
+std::string origins_problem(const LabelledMesh& S, const Mesh& A, const Mesh& B,
+                            bool exact_facets) {
   if (S.origins.size() != S.mesh.n_faces()) {
-    return std::to_string(S.origins.size()) + " origins for " + std::to_string(S.mesh.n_faces()) + " faces";
+    return std::to_string(S.origins.size()) + " origins for " + std::to_string(S.mesh.n_faces()) +
+           " faces";
   }
   for (auto f : S.mesh.faces()) {
     const FacetOrigin& o = S.origins[f.idx()];
     const std::string name = "face " + std::to_string(f.idx());
-    if (!valid_element(A, o.a) || !valid_element(B, o.b)) return name + ": origin names no element of A or B";
+    if (!valid_element(A, o.a) || !valid_element(B, o.b))
+      return name + ": origin names no element of A or B";
     std::set<Position> face;
     for (auto v : S.mesh.fv_range(f)) {
       const Point& p = S.mesh.point(v);
       face.insert({p[0], p[1], p[2]});
     }
-    const std::set<Position> sums = sums_of(A, element_vertices(A, o.a), B, element_vertices(B, o.b));
+    const std::set<Position> sums =
+        sums_of(A, element_vertices(A, o.a), B, element_vertices(B, o.b));
     if (!exact_facets) {
-      if (o.kind == FacetKind::edge && (o.a.kind != Element::Kind::edge || o.b.kind != Element::Kind::edge))
+      if (o.kind == FacetKind::edge &&
+          (o.a.kind != Element::Kind::edge || o.b.kind != Element::Kind::edge))
         return name + ": edge facet not from two edges";
       continue;
     }
@@ -106,15 +111,20 @@ std::string origins_problem(const LabelledMesh& S, const Mesh& A, const Mesh& B,
     switch (o.kind) {
       case FacetKind::translated:
         if (o.a.kind != K::facet) return name + ": translated facet whose A element is not a facet";
-        if (o.b.kind == K::vertex && face != sums) return name + ": not facet a of A moved by vertex b";
+        if (o.b.kind == K::vertex && face != sums)
+          return name + ": not facet a of A moved by vertex b";
         break;
       case FacetKind::corner:
-        if (o.b.kind != K::facet || o.a.kind == K::facet) return name + ": corner facet not (vertex|edge of A, facet of B)";
-        if (o.a.kind == K::vertex && face != sums) return name + ": not facet b of B placed at vertex a";
+        if (o.b.kind != K::facet || o.a.kind == K::facet)
+          return name + ": corner facet not (vertex|edge of A, facet of B)";
+        if (o.a.kind == K::vertex && face != sums)
+          return name + ": not facet b of B placed at vertex a";
         break;
       case FacetKind::edge:
-        if (o.a.kind != K::edge || o.b.kind != K::edge) return name + ": edge facet not from two edges";
-        if (S.mesh.valence(f) != 4 || face != sums) return name + ": edge facet is not the parallelogram of its edges";
+        if (o.a.kind != K::edge || o.b.kind != K::edge)
+          return name + ": edge facet not from two edges";
+        if (S.mesh.valence(f) != 4 || face != sums)
+          return name + ": edge facet is not the parallelogram of its edges";
         break;
     }
   }
@@ -122,8 +132,8 @@ std::string origins_problem(const LabelledMesh& S, const Mesh& A, const Mesh& B,
 }
 
 std::size_t count_kind(const LabelledMesh& S, FacetKind kind) {
-  return static_cast<std::size_t>(
-      std::count_if(S.origins.begin(), S.origins.end(), [&](const FacetOrigin& o) { return o.kind == kind; }));
+  return static_cast<std::size_t>(std::count_if(
+      S.origins.begin(), S.origins.end(), [&](const FacetOrigin& o) { return o.kind == kind; }));
 }
 
 // A (+) B against the oracle; exact comparison when both operands are exactly planar.
@@ -139,7 +149,8 @@ void check_sum(const Mesh& A, const Mesh& B, const std::string& name) {
   // Features of the exact sum below the feature size are merged by the library: then
   // the result is the exact sum only to within that size, and a merged facet holds
   // vertices of the facets it absorbed besides those of its origin.
-  const std::string feature = subresolution_feature(want, kLibraryFeatureTolerance * bbox_diagonal(S.mesh));
+  const std::string feature =
+      subresolution_feature(want, kLibraryFeatureTolerance * bbox_diagonal(S.mesh));
   const std::string origins = origins_problem(S, A, B, feature.empty());
   CHECK_MESSAGE(origins.empty(), origins);
   if (planar_operands && feature.empty()) {
@@ -157,8 +168,9 @@ void check_sum(const Mesh& A, const Mesh& B, const std::string& name) {
         all_sums.insert({s[0], s[1], s[2]});
       }
     }
-    const bool all_are_sums = std::all_of(got.vertices.begin(), got.vertices.end(),
-                                          [&](const Position& p) { return all_sums.count(p) == 1; });
+    const bool all_are_sums =
+        std::all_of(got.vertices.begin(), got.vertices.end(),
+                    [&](const Position& p) { return all_sums.count(p) == 1; });
     CHECK_MESSAGE(all_are_sums, "an output vertex is not a double sum a_i + b_j");
     const double tol = planar_operands ? kLibraryFeatureTolerance : kApproxDistance;
     const std::string diff = compare_close(got, want, tol * bbox_diagonal(S.mesh), kApproxVolume);
@@ -166,10 +178,11 @@ void check_sum(const Mesh& A, const Mesh& B, const std::string& name) {
     CHECK(got.facet_count <= want.facet_count);
   }
   // Nothing below the feature size is left (half of it: a margin for the rounding).
-  const std::string left = subresolution_feature(got, kResultFeatureTolerance * bbox_diagonal(S.mesh));
+  const std::string left =
+      subresolution_feature(got, kResultFeatureTolerance * bbox_diagonal(S.mesh));
   CHECK_MESSAGE(left.empty(), "the result has ", left);
-  const std::string clean =
-      clean_mesh_problem(S.mesh, planar_operands && feature.empty() ? clean_options_for(want) : kRoundedClean);
+  const std::string clean = clean_mesh_problem(
+      S.mesh, planar_operands && feature.empty() ? clean_options_for(want) : kRoundedClean);
   CHECK_MESSAGE(clean.empty(), clean);
 }
 
@@ -191,13 +204,15 @@ std::vector<Pair> random_pairs() {
                      random_cube_polytope(12, 300 + s, 0.25)});
   }
   for (std::uint64_t s = 1; s <= 10; ++s) {
-    pairs.push_back({"integer hulls seed " + std::to_string(s), random_integer_polytope(14, 400 + s, 3),
+    pairs.push_back({"integer hulls seed " + std::to_string(s),
+                     random_integer_polytope(14, 400 + s, 3),
                      random_integer_polytope(8, 500 + s, s % 2 ? 1 : 2)});
   }
   for (std::uint64_t s = 1; s <= 4; ++s) {
     const Mesh A = random_integer_polytope(12, 600 + s, 2);
     pairs.push_back({"integer A + A seed " + std::to_string(s), A, A});
-    pairs.push_back({"integer A + (A + t) seed " + std::to_string(s), A, translated(A, Point(3, -1, 7))});
+    pairs.push_back(
+        {"integer A + (A + t) seed " + std::to_string(s), A, translated(A, Point(3, -1, 7))});
     pairs.push_back({"integer A + (-A) seed " + std::to_string(s), A, reflected(A)});
   }
   for (std::uint64_t s = 1; s <= 3; ++s) {
@@ -205,14 +220,16 @@ std::vector<Pair> random_pairs() {
     pairs.push_back({"sphere A + A seed " + std::to_string(s), A, A});
     pairs.push_back({"sphere A + (-A) seed " + std::to_string(s), A, reflected(A)});
     const Mesh G = random_grid_polytope(24, 750 + s);
-    pairs.push_back({"grid A + (A + t) seed " + std::to_string(s), G, translated(G, Point(0.5, -0.25, 3.0))});
+    pairs.push_back(
+        {"grid A + (A + t) seed " + std::to_string(s), G, translated(G, Point(0.5, -0.25, 3.0))});
     // Copies scaled by powers of two (exactly: same_normal's similar cycles) and by 0.3.
     pairs.push_back({"sphere A + 0.5 A seed " + std::to_string(s), A, scaled(A, 0.5)});
     pairs.push_back({"grid A + (0.25 A + t) seed " + std::to_string(s), G,
                      translated(scaled(G, 0.25), Point(0.5, -0.25, 3.0))});
     pairs.push_back({"sphere A + 0.3 A seed " + std::to_string(s), A, scaled(A, 0.3)});
   }
-  pairs.push_back({"icosphere A + 0.5 A", make_icosphere(1.0, 2), scaled(make_icosphere(1.0, 2), 0.5)});
+  pairs.push_back(
+      {"icosphere A + 0.5 A", make_icosphere(1.0, 2), scaled(make_icosphere(1.0, 2), 0.5)});
   for (std::uint64_t s = 1; s <= 5; ++s) {
     pairs.push_back({"rotated cube (triangles) + sphere hull seed " + std::to_string(s),
                      rotated_cube_triangles(1.0, 800 + s), random_sphere_polytope(15, 850 + s)});
@@ -224,7 +241,8 @@ std::vector<Pair> random_pairs() {
   pairs.push_back({"tetrahedron + octahedron", tetrahedron(1.0), octahedron(1.0)});
   pairs.push_back({"tetrahedron + (-tetrahedron)", tetrahedron(1.0), reflected(tetrahedron(1.0))});
   pairs.push_back({"integer hull + cube", random_integer_polytope(16, 1001, 3), cube(1.0)});
-  pairs.push_back({"integer hull + octahedron", random_integer_polytope(16, 1002, 3), octahedron(1.0)});
+  pairs.push_back(
+      {"integer hull + octahedron", random_integer_polytope(16, 1002, 3), octahedron(1.0)});
   return pairs;
 }
 
@@ -263,20 +281,26 @@ TEST_CASE("fims: oracle self-check on analytic sums") {
   // The clean-mesh check rejects what it must.
   CHECK(clean_mesh_problem(cube(1.0)).empty());
   CHECK(clean_mesh_problem(random_integer_polytope(14, 1, 3)).empty());
-  CHECK(clean_mesh_problem(reflected(cube(1.0))).empty());               // -cube is an outward cube
-  CHECK_FALSE(clean_mesh_problem(scaled(cube(1.0), -1.0)).empty());       // negated only: inward
+  CHECK(clean_mesh_problem(reflected(cube(1.0))).empty());           // -cube is an outward cube
+  CHECK_FALSE(clean_mesh_problem(scaled(cube(1.0), -1.0)).empty());  // negated only: inward
   {
     // Two coplanar triangles where one quad should be.
     const std::vector<Point> p = {Point(0, 0, 0), Point(1, 0, 0), Point(0, 1, 0), Point(1, 1, 0),
                                   Point(0, 0, 1), Point(1, 0, 1), Point(0, 1, 1), Point(1, 1, 1)};
-    const Mesh split = mesh_from_polygons(
-        p, {{0, 2, 3}, {0, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}});
+    const Mesh split = mesh_from_polygons(p, {{0, 2, 3},
+                                              {0, 3, 1},
+                                              {4, 5, 7, 6},
+                                              {0, 1, 5, 4},
+                                              {2, 6, 7, 3},
+                                              {0, 4, 6, 2},
+                                              {1, 3, 7, 5}});
     CHECK(clean_mesh_problem(split).find("coplanar") != std::string::npos);
     // A vertex in the middle of an edge.
     std::vector<Point> q = p;
     q.push_back(Point(0.5, 0, 0));
     const Mesh mid = mesh_from_polygons(
-        q, {{0, 2, 3, 1, 8}, {4, 5, 7, 6}, {0, 8, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}});
+        q,
+        {{0, 2, 3, 1, 8}, {4, 5, 7, 6}, {0, 8, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}});
     CHECK(clean_mesh_problem(mid).find("distinct face planes") != std::string::npos);
     // A tetrahedron whose bottom is dented in towards its apex: not convex.
     const Mesh nonconvex = mesh_from_polygons(
@@ -289,7 +313,8 @@ TEST_CASE("fims: oracle self-check on analytic sums") {
 // ---------------------------------------------------------------------------------------
 // Oracle comparisons
 
-TEST_CASE("fims: random, integer, rotated, self, translated and reflected pairs match the exact hull") {
+TEST_CASE(
+    "fims: random, integer, rotated, self, translated and reflected pairs match the exact hull") {
   const std::vector<Pair> pairs = random_pairs();
   REQUIRE(pairs.size() >= 50);
   for (const Pair& p : pairs) check_sum(p.A, p.B, p.name);
@@ -300,18 +325,20 @@ TEST_CASE("fims: every pair of small samples matches the exact hull") {
   std::vector<std::pair<std::string, Mesh>> operands;
   for (const auto& path : sample_operands()) {
     const Mesh m = read_mesh(path);
-    if (m.n_vertices() > 400) continue;                // keep the n^2 pairs quick
+    if (m.n_vertices() > 400) continue;              // keep the n^2 pairs quick
     if (!check_convex_polyhedron(m).ok()) continue;  // samples of invalid input
     operands.emplace_back(path.filename().string(), m);
   }
-  REQUIRE_MESSAGE(operands.size() >= 3, "expected at least 3 small convex samples/*.off in ", MORPH_SAMPLES_DIR);
+  REQUIRE_MESSAGE(operands.size() >= 3, "expected at least 3 small convex samples/*.off in ",
+                  MORPH_SAMPLES_DIR);
   for (const auto& [na, A] : operands) {
     for (const auto& [nb, B] : operands) check_sum(A, B, na + " + " + nb);
   }
 }
 
 TEST_CASE("fims: library elements match the exact hull") {
-  check_sum(make_icosphere(1.0, 1), random_sphere_polytope(20, 42, 0.5), "icosphere(1) + sphere hull");
+  check_sum(make_icosphere(1.0, 1), random_sphere_polytope(20, 42, 0.5),
+            "icosphere(1) + sphere hull");
   check_sum(make_box(1.0, 2.0, 0.5), make_tetrahedron(0.7), "box + tetrahedron");
   check_sum(make_octahedron(1.0), make_icosphere(0.3, 2), "octahedron + icosphere(2)");
   check_sum(random_integer_polytope(15, 77, 3), make_box(0.5, 0.25, 1.0), "integer hull + box");
@@ -323,8 +350,10 @@ TEST_CASE("fims: approximately planar operands agree with the exact hull within 
   check_sum(make_snub_dodecahedron(1.0), tetrahedron(0.3), "snub dodecahedron + tetrahedron");
   check_sum(make_dodecahedron(1.0), make_icosahedron(0.5), "dodecahedron + icosahedron");
   for (std::uint64_t s = 1; s <= 3; ++s) {
-    check_sum(rotated_cube_quads(1.0, 1100 + s), rotated_cube_quads(0.7, 1200 + s), "rotated quads");
-    check_sum(rotated_cube_quads(1.0, 1300 + s), random_sphere_polytope(12, 1400 + s, 0.4), "rotated quads + hull");
+    check_sum(rotated_cube_quads(1.0, 1100 + s), rotated_cube_quads(0.7, 1200 + s),
+              "rotated quads");
+    check_sum(rotated_cube_quads(1.0, 1300 + s), random_sphere_polytope(12, 1400 + s, 0.4),
+              "rotated quads + hull");
   }
 }
 
@@ -364,7 +393,8 @@ TEST_CASE("fims: cube plus octahedron is the expanded cube") {
     CHECK(count_kind(S, FacetKind::edge) == 12);
     // Mixed volumes: V(C) + sum over C's facets of h_O(n) area + sum over O's facets of
     // h_C(n) area + V(O) = 8 + 24 r + 12 r^2 + 4/3 r^3.
-    CHECK(d.volume == doctest::Approx(8 + 24 * r + 12 * r * r + 4.0 / 3.0 * r * r * r).epsilon(1e-13));
+    CHECK(d.volume ==
+          doctest::Approx(8 + 24 * r + 12 * r * r + 4.0 / 3.0 * r * r * r).epsilon(1e-13));
     CHECK(exact_hull_of_sums(cube(2.0), octahedron(r)).volume ==
           doctest::Approx(8 + 24 * r + 12 * r * r + 4.0 / 3.0 * r * r * r).epsilon(1e-13));
   }
@@ -385,14 +415,16 @@ TEST_CASE("fims: cube plus regular tetrahedron (the paper's example)") {
   CHECK(count_kind(S, FacetKind::edge) == 0);
   CHECK(count_kind(S, FacetKind::corner) == 4);
   CHECK(count_kind(S, FacetKind::translated) == 6);
-  CHECK(d.volume == doctest::Approx(8 + 24 * s + 24 * s * s + 8.0 / 3.0 * s * s * s).epsilon(1e-13));
+  CHECK(d.volume ==
+        doctest::Approx(8 + 24 * s + 24 * s * s + 8.0 / 3.0 * s * s * s).epsilon(1e-13));
   CHECK(compare_exact(d, exact_hull_of_sums(cube(2.0), tetrahedron(s))).empty());
   CHECK(origins_problem(S, cube(2.0), tetrahedron(s), true).empty());
 }
 
 TEST_CASE("fims: A plus A is 2A with the facet degrees of A") {
   for (std::uint64_t seed : {11u, 12u, 13u}) {
-    const Mesh A = seed == 11 ? random_integer_polytope(15, seed, 3) : random_sphere_polytope(25, seed);
+    const Mesh A =
+        seed == 11 ? random_integer_polytope(15, seed, 3) : random_sphere_polytope(25, seed);
     const LabelledMesh S = minkowski_sum(A, A);
     const Description d = describe(S.mesh);
     CHECK(compare_exact(d, describe(scaled(A, 2.0))).empty());
@@ -411,10 +443,13 @@ TEST_CASE("fims: A plus a scaled copy of A is the scaled A, and the result chain
     const LabelledMesh S = minkowski_sum(A, B);
     CHECK(S.mesh.n_vertices() == A.n_vertices());
     CHECK(S.mesh.n_faces() == A.n_faces());
-    const std::string close = compare_close(describe(S.mesh), describe(scaled(A, 1.1)), 1e-12 * 2.2, 1e-12);
+    const std::string close =
+        compare_close(describe(S.mesh), describe(scaled(A, 1.1)), 1e-12 * 2.2, 1e-12);
     CHECK_MESSAGE(close.empty(), close);
-    CHECK_MESSAGE(clean_mesh_problem(S.mesh, kRoundedClean).empty(), clean_mesh_problem(S.mesh, kRoundedClean));
-    CHECK(subresolution_feature(describe(S.mesh), kResultFeatureTolerance * bbox_diagonal(S.mesh)).empty());
+    CHECK_MESSAGE(clean_mesh_problem(S.mesh, kRoundedClean).empty(),
+                  clean_mesh_problem(S.mesh, kRoundedClean));
+    CHECK(subresolution_feature(describe(S.mesh), kResultFeatureTolerance * bbox_diagonal(S.mesh))
+              .empty());
     // The result is a valid operand again (it used to keep zero-area needles).
     CHECK(check_convex_polyhedron(S.mesh).ok());
     const LabelledMesh S2 = minkowski_sum(S.mesh, B);
@@ -436,7 +471,7 @@ TEST_CASE("fims: an element away from the origin translates the sum") {
 }
 
 TEST_CASE("fims: output is identical for any thread count") {
-  const Mesh big = make_icosphere(1.0, 3);                                    // 1280 triangles
+  const Mesh big = make_icosphere(1.0, 3);                                      // 1280 triangles
   const Mesh small = transformed(make_icosphere(0.4, 2), random_rotation(31));  // 320 triangles
   REQUIRE(big.n_faces() == 1280);
   REQUIRE(small.n_faces() == 320);
@@ -489,7 +524,8 @@ TEST_CASE("fims: the hull fallback gives the same output on every run and thread
   CHECK_MESSAGE(diff.empty(), diff);
 }
 
-TEST_CASE("fims: result vertices are numbered in the order of their pairs (vertex of A, vertex of B)") {
+TEST_CASE(
+    "fims: result vertices are numbered in the order of their pairs (vertex of A, vertex of B)") {
   // Grid coordinates: every vertex sum is exact, so each result vertex names its pair
   // (a vertex of a sum of convex bodies is the sum of exactly one pair of vertices).
   for (std::uint64_t s = 1; s <= 3; ++s) {

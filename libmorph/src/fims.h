@@ -21,7 +21,8 @@ struct SumFacets {
 };
 
 inline std::uint64_t pair_key(int i, int j) {
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(i)) << 32) | static_cast<std::uint32_t>(j);
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(i)) << 32) |
+         static_cast<std::uint32_t>(j);
 }
 inline int pair_first(std::uint64_t k) { return static_cast<int>(k >> 32); }
 inline int pair_second(std::uint64_t k) { return static_cast<int>(k & 0xffffffffu); }

@@ -7,8 +7,8 @@
 #include <atomic>
 #include <cmath>
 #include <initializer_list>
-#include <memory>
 #include <limits>
+#include <memory>
 #include <numeric>
 
 #include "fims.h"
