@@ -18,9 +18,6 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/convex_hull_3.h>
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 #include <morph/error.h>
 
 #include <algorithm>
@@ -35,6 +32,7 @@
 #include <queue>
 #include <type_traits>
 
+#include "double_pair.h"
 #include "fims.h"
 #include "parallel.h"
 #include "union_find.h"
@@ -267,27 +265,6 @@ struct FacetGeometry {
   double longest_edge;
 };
 
-/// Two doubles operated on lane by lane (GCC and Clang vector extensions).
-using Pair = double __attribute__((vector_size(16)));
-
-Pair pair_sqrt(Pair x) {
-#if defined(__SSE2__)
-  return _mm_sqrt_pd(x);
-#else
-  return Pair{std::sqrt(x[0]), std::sqrt(x[1])};
-#endif
-}
-
-/// std::max(a, b) (b if a < b, else a: the same for zeros of either sign and NaNs) in one
-/// instruction, never a branch (which of a facet's edges is the longest is irregular).
-double max_of(double a, double b) {
-#if defined(__SSE2__)
-  return _mm_cvtsd_f64(_mm_max_sd(_mm_set_sd(b), _mm_set_sd(a)));  // b > a ? b : a
-#else
-  return std::max(a, b);
-#endif
-}
-
 /// A facet's geometry from its first corner (`origin`), Newell's normal (`sum`, twice the
 /// vector area), the sum of its corners' offsets from the origin, its longest squared edge
 /// and its degree.
@@ -380,15 +357,6 @@ FacetGeometry quad_geometry(const std::vector<V3<double>>& points, const Soup& s
   const double longest_squared =
       max_of(max_of(max_of(max_of(0.0, dot(q1, q1)), dot(e1, e1)), dot(e2, e2)), dot(q3, q3));
   return finish_geometry(origin, sum, (plus_zero(q1) + q2) + q3, longest_squared, 4);
-}
-
-/// std::max per lane (max_of in each).
-Pair pair_max(Pair a, Pair b) {
-#if defined(__SSE2__)
-  return _mm_max_pd(b, a);  // b > a ? b : a, lane by lane
-#else
-  return Pair{max_of(a[0], b[0]), max_of(a[1], b[1])};
-#endif
 }
 
 /// triangle_geometry (Degree 3) or quad_geometry (4) of facets f and f + 1 at once, one in

@@ -7,10 +7,6 @@
 #include <morph/error.h>
 #include <morph/validate.h>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -22,6 +18,7 @@
 #include <utility>
 #include <vector>
 
+#include "double_pair.h"
 #include "polytope.h"
 #include "validate_detail.h"
 
@@ -476,9 +473,9 @@ struct PlaneHeight {
   }
 };
 
-// Two doubles operated on lane by lane (GCC and Clang vector extensions): each lane's
-// operations are the scalar ones, so each lane's value is the scalar value.
-using Pair = double __attribute__((vector_size(16)));
+using detail::both_at_most;
+using detail::Pair;
+using detail::pair_abs;
 
 // PlaneHeight of two points at once, one in each lane: the same values, in half the
 // operations (quad_passes() takes eight heights of each quadrilateral's neighbours).
@@ -496,22 +493,6 @@ struct PlaneHeights {
     return (x - cx) * nx + (y - cy) * ny + (z - cz) * nz;
   }
 };
-
-// Whether both lanes of h are <= bound (false for a NaN, as the scalar test).
-inline bool both_at_most(Pair h, Pair bound) {
-#if defined(__SSE2__)
-  return _mm_movemask_pd(_mm_cmple_pd(h, bound)) == 3;
-#else
-  return h[0] <= bound[0] && h[1] <= bound[1];
-#endif
-}
-
-// |h| lane by lane (the sign bit cleared, as std::abs).
-inline Pair pair_abs(Pair h) {
-  using Bits = long long __attribute__((vector_size(16)));
-  constexpr Bits kMagnitude{0x7fffffffffffffffLL, 0x7fffffffffffffffLL};
-  return reinterpret_cast<Pair>(reinterpret_cast<Bits>(h) & kMagnitude);
-}
 
 // A corner's coordinates: doubles, or Pairs holding one face's corner in each lane.
 template <class T>
