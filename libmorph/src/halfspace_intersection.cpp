@@ -766,9 +766,9 @@ int double_side(const Plane& p, const HVertex& v) {
   if (!p.fast || !v.fast) return 2;
   const V3<double> X = v.Xd(), M = v.MX();
   const double value = p.nd.x * X.x + p.nd.y * X.y + p.nd.z * X.z - p.dd * v.Wd();
-  const double bound = kSideError * (std::abs(p.nd.x) * M.x + std::abs(p.nd.y) * M.y +
-                                     std::abs(p.nd.z) * M.z + p.da() * v.MW()) +
-                       kDoubleFloor;
+  const V3<double> na = p.na();
+  const double bound =
+      kSideError * (na.x * M.x + na.y * M.y + na.z * M.z + p.da() * v.MW()) + kDoubleFloor;
   if (value > bound) return 1;
   if (value < -bound) return -1;
   return 2;
