@@ -364,37 +364,57 @@ FacetGeometry quad_geometry(const std::vector<V3<double>>& points, const Soup& s
 /// packed operation is the scalar one, IEEE), in about half the instructions. A lane whose
 /// facet has no area is given zeros as the one-facet function would (its quotients are
 /// not used); a sum that is not finite takes the one-facet functions.
+/// Also pass 1's filter of the two facets (`surely_apart` in clean_mesh), from the points
+/// loaded once: whether each is apart, no pair of its corners within `far` (squared) nor
+/// repeated. A corner's offset from the first, q = p - origin, is the negation of
+/// origin - p (IEEE rounding is symmetric), so dot(q, q) is that pair's squared distance.
 template <int Degree>
-void geometry_pair(const std::vector<V3<double>>& points, const Soup& soup, int f,
-                   FacetGeometry* geo) {
+std::array<bool, 2> geometry_pair(const std::vector<V3<double>>& points, const Soup& soup, int f,
+                                  FacetGeometry* geo, double far = 0) {
   const int* const v = soup.vertex.data() + soup.begin[f];
   const int* const w = v + Degree;  // facet f + 1's corners follow f's
   const auto load = [&](int k) {
     const V3<double>&p = points[v[k]], &q = points[w[k]];
     return V3<Pair>{Pair{p.x, q.x}, Pair{p.y, q.y}, Pair{p.z, q.z}};
   };
-  const Pair zero{0, 0};
-  const V3<Pair> origin = load(0), q1 = load(1) - origin, q2 = load(2) - origin;
+  const auto squared = [](const V3<Pair>& p, const V3<Pair>& q) {
+    const V3<Pair> d = p - q;
+    return dot(d, d);
+  };
+  const Pair zero{0, 0}, bound{far, far};
+  const V3<Pair> origin = load(0), p1 = load(1), p2 = load(2);
+  const V3<Pair> q1 = p1 - origin, q2 = p2 - origin;
+  const Pair s1 = dot(q1, q1), s2 = dot(q2, q2);
+  auto near = (s1 <= bound) | (s2 <= bound) | (squared(p1, p2) <= bound);
   V3<Pair> sum, centroid;
   Pair longest_squared;
   if constexpr (Degree == 3) {
     sum = plus_zero(cross(q1, q2));
     const V3<Pair> e = q2 - q1;
-    longest_squared = pair_max(pair_max(pair_max(zero, dot(q1, q1)), dot(e, e)), dot(q2, q2));
+    longest_squared = pair_max(pair_max(pair_max(zero, s1), dot(e, e)), s2);
     centroid = plus_zero(q1) + q2;
   } else {
-    const V3<Pair> q3 = load(3) - origin;
+    const V3<Pair> p3 = load(3);
+    const V3<Pair> q3 = p3 - origin;
+    const Pair s3 = dot(q3, q3);
+    near |= (s3 <= bound) | (squared(p1, p3) <= bound) | (squared(p2, p3) <= bound);
     sum = plus_zero(cross(q1, q2)) + cross(q2, q3);
     const V3<Pair> e1 = q2 - q1, e2 = q3 - q2;
-    longest_squared = pair_max(
-        pair_max(pair_max(pair_max(zero, dot(q1, q1)), dot(e1, e1)), dot(e2, e2)), dot(q3, q3));
+    longest_squared =
+        pair_max(pair_max(pair_max(pair_max(zero, s1), dot(e1, e1)), dot(e2, e2)), s3);
     centroid = (plus_zero(q1) + q2) + q3;
   }
+  const auto repeated = [](const int* u) {
+    if constexpr (Degree == 3) return (u[0] == u[1]) | (u[0] == u[2]) | (u[1] == u[2]);
+    return (u[0] == u[1]) | (u[0] == u[2]) | (u[0] == u[3]) | (u[1] == u[2]) | (u[1] == u[3]) |
+           (u[2] == u[3]);
+  };
+  const std::array<bool, 2> apart{!(near[0] | repeated(v)), !(near[1] | repeated(w))};
   const Pair squared_area = dot(sum, sum);
   if (!(squared_area[0] <= kLargest) || !(squared_area[1] <= kLargest)) {
     for (int g = f; g < f + 2; ++g)
       geo[g] = Degree == 3 ? triangle_geometry(points, soup, g) : quad_geometry(points, soup, g);
-    return;
+    return apart;
   }
   const Pair longest = pair_sqrt(longest_squared), area = pair_sqrt(squared_area);
   const V3<Pair> normal{sum.x / area, sum.y / area, sum.z / area};
@@ -417,6 +437,7 @@ void geometry_pair(const std::vector<V3<double>>& points, const Soup& soup, int 
       g.offset = offset[i];
     }
   }
+  return apart;
 }
 
 bool is_thin(const FacetGeometry& g, double limit) {
@@ -894,6 +915,7 @@ void geometries(const std::vector<V3<double>>& points, const Soup& soup, FacetGe
 /// What pass 2 starts from: the soup's connectivity (nothing when it is not a closed
 /// manifold) and its facets' geometry, when they were found beforehand (`geo` set).
 struct Prepared {
+  bool connected = false;  // whether `k` was looked for
   std::optional<Connectivity> k;
   std::unique_ptr<FacetGeometry[]> geo;
 };
@@ -920,6 +942,8 @@ std::optional<std::pair<Soup, Connectivity>> simplify(const std::vector<V3<doubl
       k = connect(static_cast<int>(points.size()), soup);
       if (k) geometries(points, soup, pre.geo.get());
     }
+  } else if (!pre.connected) {
+    k = connect(static_cast<int>(points.size()), soup);
   }
   if (!k) return std::nullopt;
   const FacetGeometry* const geo = pre.geo.get();
@@ -1273,10 +1297,10 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
   soup.begin = face_begin;
   soup.vertex = std::move(facet_corners);
   const std::vector<int>& corners = soup.vertex;
-  // With threads to spare, the soup's connectivity and its facets' geometry (pass 2's
-  // input) are found beside pass 1, on the chance that the facets are the soup as they
-  // are (rather than `simplify` splitting each into chunks too short to pay at a few
-  // thousand facets). They are dropped if not.
+  // The facets' geometry (pass 2's input) is found in pass 1's search, from the points it
+  // loads, on the chance that the facets are the soup as they are; with threads to spare,
+  // so is the soup's connectivity, beside pass 1 (rather than `simplify` splitting each
+  // into chunks too short to pay at a few thousand facets). They are dropped if not.
   const bool ahead = nf >= kFacetGrain && tbb::this_task_arena::max_concurrency() > 1;
   Prepared pre;
   UnionFind clusters(n);
@@ -1354,12 +1378,30 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
     std::atomic<bool> some_close{false};
     parallel_chunks(nf, kFacetGrain, [&](int first, int last) {
       bool found = false;
-      for (int f = first; f < last; ++f) {
+      const auto test = [&](int f, bool apart) {
         bool here = false;
-        if (!surely_apart(f))
-          for_pairs(f, [&](int u, int w) { here = here || u == w || close(u, w); });
+        if (!apart) for_pairs(f, [&](int u, int w) { here = here || u == w || close(u, w); });
         has_close[f] = here;
         found = found || here;
+      };
+      FacetGeometry* const geo = pre.geo.get();
+      for (int f = first; f < last; ++f) {
+        // Two facets of one degree at once when they follow each other (nearly all), with
+        // their geometry from the same points.
+        const int d = face_begin[f + 1] - face_begin[f];
+        if (f + 1 < last && (d == 3 || d == 4) && face_begin[f + 2] - face_begin[f + 1] == d) {
+          const std::array<bool, 2> apart = d == 3 ? geometry_pair<3>(points, soup, f, geo, far)
+                                                   : geometry_pair<4>(points, soup, f, geo, far);
+          test(f, apart[0]);
+          test(f + 1, apart[1]);
+          ++f;
+          continue;
+        }
+        if (d >= 3)  // (a facet of fewer corners is not the soup's)
+          geo[f] = d == 3   ? triangle_geometry(points, soup, f)
+                   : d == 4 ? quad_geometry(points, soup, f)
+                            : geometry(points, soup, f);
+        test(f, surely_apart(f));
       }
       if (found) some_close.store(true, std::memory_order_relaxed);
     });
@@ -1386,15 +1428,14 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
       }
     }
     as_given = given;
-    if (ahead && as_given) {
-      pre.geo = std::make_unique_for_overwrite<FacetGeometry[]>(nf);
-      geometries(points, soup, pre.geo.get());
-    }
   };
-  if (ahead)
+  pre.geo = std::make_unique_for_overwrite<FacetGeometry[]>(nf);
+  if (ahead) {
     run_both(find_close, [&] { pre.k = connect(n, soup); });
-  else
+    pre.connected = true;
+  } else {
     find_close();
+  }
   bool repeated = false;
   if (as_given) {
     soup.source.resize(nf);
