@@ -464,29 +464,33 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
   std::vector<int> reference(nf), last_member(nf);
   std::iota(reference.begin(), reference.end(), 0);
   std::iota(last_member.begin(), last_member.end(), 0);
+  // Plain pointers: loaded once, not through the captures for each test.
+  const V3<double>* const point = points.data();
+  const int *const vertex = soup.vertex.data(), *const begin = soup.begin.data();
+  // All vertices of facet `g`, a group alone, within `limit` of the plane of facet `ref`;
+  // `edge`: g's corner on the edge that the two share. Its corners from the one after the
+  // shared edge on, as the edge's ends are on the plane when the groups already meet
+  // there. Which corner fails first does not change the answer.
+  const auto holds_alone = [=](int ref, int g, int edge) {
+    const FacetGeometry& p = geo[ref];
+    if (is_thin(p, limit)) return false;
+    // A facet's corners are consecutive (next is the one after, or the first after the
+    // last): found so rather than through `next`, whose loads would delay the first test.
+    const int b = begin[g], e = begin[g + 1], d = e - b;
+    int c = edge + 2 >= e ? edge + 2 - d : edge + 2;  // d >= 3
+    for (int i = 0; i < d; ++i, c = c + 1 == e ? b : c + 1)
+      if (std::abs(dot(p.normal, point[vertex[c]]) - p.offset) > limit) return false;
+    return true;
+  };
   // All vertices of group `g` within `limit` of the plane of facet `ref`; `edge`: g's corner
   // on the edge that the two groups share.
   auto holds = [&](int ref, int g, int edge) {
+    if (next_member[g] < 0) return holds_alone(ref, g, edge);  // one facet, named by it
     const FacetGeometry& p = geo[ref];
     if (is_thin(p, limit)) return false;
-    const auto off = [&](int c) {
-      return std::abs(dot(p.normal, points[soup.vertex[c]]) - p.offset) > limit;
-    };
-    if (next_member[g] < 0) {
-      // One facet (the group is named by it, and has the edge): its corners from the one
-      // after the shared edge on, as the edge's ends are on the plane when the groups
-      // already meet there. Which corner fails first does not change the answer.
-      // A facet's corners are consecutive (next is the one after, or the first after the
-      // last): found so rather than through `next`, whose loads would delay the first test.
-      const int b = soup.begin[g], e = soup.begin[g + 1], d = e - b;
-      int c = edge + 2 >= e ? edge + 2 - d : edge + 2;  // d >= 3
-      for (int i = 0; i < d; ++i, c = c + 1 == e ? b : c + 1)
-        if (off(c)) return false;
-      return true;
-    }
     for (int f = g; f >= 0; f = next_member[f])
-      for (int c = soup.begin[f]; c < soup.begin[f + 1]; ++c)
-        if (off(c)) return false;
+      for (int c = begin[f]; c < begin[f + 1]; ++c)
+        if (std::abs(dot(p.normal, point[vertex[c]]) - p.offset) > limit) return false;
     return true;
   };
   const int nc = static_cast<int>(soup.vertex.size());
@@ -511,7 +515,8 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
           std::swap(a, b);
           edge_b = c;
         }
-        if (a != b && holds(a, b, edge_b)) passed[block].push_back(c);
+        // (Every facet is alone before the joins.)
+        if (a != b && holds_alone(a, b, edge_b)) passed[block].push_back(c);
       }
   });
   std::vector<char> alone(nf, 1);
