@@ -335,6 +335,32 @@ TEST_CASE("clean_mesh finds a close pair in either facet of two taken together")
         }
 }
 
+// A facet of fewer than three corners is dropped before the facets' connectivity is found,
+// wherever it is among them (pass 1 tells from its own loop whether any facet needs the
+// check): the cube, without the hull.
+TEST_CASE("clean_mesh drops facets of fewer than three corners at any place") {
+  for (const std::vector<int>& stub :
+       {std::vector<int>{}, std::vector<int>{4}, std::vector<int>{4, 5}})
+    for (int at = 0; at <= 6; ++at) {
+      CAPTURE(stub);
+      CAPTURE(at);
+      std::vector<std::vector<int>> facets = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                              {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+      facets.insert(facets.begin() + at, stub);
+      std::vector<int> begin{0}, corners;
+      for (const auto& f : facets) {
+        corners.insert(corners.end(), f.begin(), f.end());
+        begin.push_back(static_cast<int>(corners.size()));
+      }
+      std::vector<int> source;
+      const long before = morph::detail::clean_mesh_hull_fallbacks();
+      const morph::Mesh mesh = clean_mesh(cube_points(), begin, corners, &source);
+      CHECK(morph::detail::clean_mesh_hull_fallbacks() == before);
+      check_cube(mesh);
+      CHECK(std::find(source.begin(), source.end(), at) == source.end());
+    }
+}
+
 // A (+) (A + t) with t rounded: the operands' facets are parallel up to the rounding, and
 // the exact sum has, along every edge of 2A, needles whose short diagonals merge (see the
 // test above). The result is 2A translated, from the regular path (no hull), and agrees

@@ -1315,10 +1315,22 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
   const auto find_close = [&] {
     V3<double> lo{0, 0, 0}, hi{0, 0, 0};
     if (n > 0) lo = hi = points[0];
-    for (const auto& p : points) {
-      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+    // The even and odd points in two boxes (half as long chains of dependent minima), then
+    // joined: the same extremes (a NaN enters only as points[0]'s, in both; which zero is
+    // kept may differ, and neither the span nor the magnitude below depends on it).
+    V3<double> lo_odd = lo, hi_odd = hi;
+    const auto extend = [](V3<double>& low, V3<double>& high, const V3<double>& p) {
+      low = {std::min(low.x, p.x), std::min(low.y, p.y), std::min(low.z, p.z)};
+      high = {std::max(high.x, p.x), std::max(high.y, p.y), std::max(high.z, p.z)};
+    };
+    int v = 0;
+    for (; v + 1 < n; v += 2) {
+      extend(lo, hi, points[v]);
+      extend(lo_odd, hi_odd, points[v + 1]);
     }
+    if (v < n) extend(lo, hi, points[v]);
+    extend(lo, hi, lo_odd);
+    extend(lo, hi, hi_odd);
     const V3<double> span = hi - lo;
     limit = kFeatureTolerance * std::sqrt(dot(span, span));
     // Points whose rounding unit exceeds the feature size (a result far from the origin for
@@ -1381,8 +1393,11 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
     // unions below are those of close corners either way.
     std::vector<char> has_close(nf, 0);
     std::atomic<bool> some_close{false};
+    // Whether a facet has fewer than three corners or is compared by its sides alone (the
+    // facets taken two at a time have three or four).
+    std::atomic<bool> some_irregular{false};
     parallel_chunks(nf, kFacetGrain, [&](int first, int last) {
-      bool found = false;
+      bool found = false, irregular = false;
       const auto test = [&](int f, bool apart) {
         bool here = false;
         if (!apart) for_pairs(f, [&](int u, int w) { here = here || u == w || close(u, w); });
@@ -1407,8 +1422,10 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
                    : d == 4 ? quad_geometry(points, soup, f)
                             : geometry(points, soup, f);
         test(f, surely_apart(f));
+        irregular = irregular || d < 3 || d > kPairwiseDegree;
       }
       if (found) some_close.store(true, std::memory_order_relaxed);
+      if (irregular) some_irregular.store(true, std::memory_order_relaxed);
     });
     any_close = some_close.load();
     if (any_close)
@@ -1422,7 +1439,8 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
     // have one (the others would have been marked above).
     bool given = !any_close;      // a local: `as_given` is the caller's
     std::vector<int> last_facet;  // the last facet a point was seen in, to find repeats
-    for (int f = 0; f < nf && given; ++f) {
+    const bool irregular = some_irregular.load();  // else every facet passes the loop below
+    for (int f = 0; f < nf && given && irregular; ++f) {
       const int b = face_begin[f], e = face_begin[f + 1];
       given = e - b >= 3;
       if (e - b <= kPairwiseDegree) continue;
