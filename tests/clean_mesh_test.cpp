@@ -286,6 +286,81 @@ TEST_CASE("clean_mesh finds a close pair at each place in a triangle, at any sca
   }
 }
 
+// Pass 1 takes consecutive triangles or quadrilaterals two at a time (with their planes): a
+// close pair is found in either facet of a pair. The cube as triangles or quadrilaterals,
+// vertex 4 of its top moved to 8 (close to 4, or not), and a sliver (4, 8, 5) or (4, 8, 5, 9),
+// 9 close to 5 (or not) and a corner of the front, at each place among the facets.
+TEST_CASE("clean_mesh finds a close pair in either facet of two taken together") {
+  for (const bool triangles : {false, true})
+    for (const double offset : {1e-13, 1e-6})
+      for (int at = 0; at <= (triangles ? 12 : 6); ++at)
+        for (int turn = 0; turn < (triangles ? 3 : 4); ++turn) {
+          CAPTURE(triangles);
+          CAPTURE(offset);
+          CAPTURE(at);
+          CAPTURE(turn);
+          std::vector<V3<double>> points = cube_points();
+          points.push_back({offset, 0, 1});  // 8: vertex 4 moved
+          points.push_back({1, offset, 1});  // 9: close to vertex 5
+          std::vector<std::vector<int>> facets;
+          std::vector<int> sliver;
+          if (triangles) {
+            facets = {{0, 2, 3}, {0, 3, 1}, {8, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+                      {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+            sliver = {4, 8, 5};
+          } else {
+            facets = {{0, 2, 3, 1}, {8, 5, 7, 6}, {0, 1, 9, 4},
+                      {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+            sliver = {4, 8, 5, 9};
+          }
+          std::rotate(sliver.begin(), sliver.begin() + turn, sliver.end());
+          facets.insert(facets.begin() + at, sliver);
+          std::vector<int> begin{0}, corners;
+          for (const auto& f : facets) {
+            corners.insert(corners.end(), f.begin(), f.end());
+            begin.push_back(static_cast<int>(corners.size()));
+          }
+          std::vector<int> source;
+          const long before = morph::detail::clean_mesh_hull_fallbacks();
+          const morph::Mesh mesh = clean_mesh(points, begin, corners, &source);
+          if (offset < 1e-9) {
+            // 8 merges into 4 and 9 into 5: the cube, the sliver gone, no hull.
+            CHECK(morph::detail::clean_mesh_hull_fallbacks() == before);
+            check_cube(mesh);
+            CHECK(std::find(source.begin(), source.end(), at) == source.end());
+          } else {
+            // Nothing merges, and an edge is used twice: only the hull mends it.
+            CHECK(morph::detail::clean_mesh_hull_fallbacks() == before + 1);
+          }
+        }
+}
+
+// A facet of fewer than three corners is dropped before the facets' connectivity is found,
+// wherever it is among them (pass 1 tells from its own loop whether any facet needs the
+// check): the cube, without the hull.
+TEST_CASE("clean_mesh drops facets of fewer than three corners at any place") {
+  for (const std::vector<int>& stub :
+       {std::vector<int>{}, std::vector<int>{4}, std::vector<int>{4, 5}})
+    for (int at = 0; at <= 6; ++at) {
+      CAPTURE(stub);
+      CAPTURE(at);
+      std::vector<std::vector<int>> facets = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                              {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+      facets.insert(facets.begin() + at, stub);
+      std::vector<int> begin{0}, corners;
+      for (const auto& f : facets) {
+        corners.insert(corners.end(), f.begin(), f.end());
+        begin.push_back(static_cast<int>(corners.size()));
+      }
+      std::vector<int> source;
+      const long before = morph::detail::clean_mesh_hull_fallbacks();
+      const morph::Mesh mesh = clean_mesh(cube_points(), begin, corners, &source);
+      CHECK(morph::detail::clean_mesh_hull_fallbacks() == before);
+      check_cube(mesh);
+      CHECK(std::find(source.begin(), source.end(), at) == source.end());
+    }
+}
+
 // A (+) (A + t) with t rounded: the operands' facets are parallel up to the rounding, and
 // the exact sum has, along every edge of 2A, needles whose short diagonals merge (see the
 // test above). The result is 2A translated, from the regular path (no hull), and agrees

@@ -364,37 +364,57 @@ FacetGeometry quad_geometry(const std::vector<V3<double>>& points, const Soup& s
 /// packed operation is the scalar one, IEEE), in about half the instructions. A lane whose
 /// facet has no area is given zeros as the one-facet function would (its quotients are
 /// not used); a sum that is not finite takes the one-facet functions.
+/// Also pass 1's filter of the two facets (`surely_apart` in clean_mesh), from the points
+/// loaded once: whether each is apart, no pair of its corners within `far` (squared) nor
+/// repeated. A corner's offset from the first, q = p - origin, is the negation of
+/// origin - p (IEEE rounding is symmetric), so dot(q, q) is that pair's squared distance.
 template <int Degree>
-void geometry_pair(const std::vector<V3<double>>& points, const Soup& soup, int f,
-                   FacetGeometry* geo) {
+std::array<bool, 2> geometry_pair(const std::vector<V3<double>>& points, const Soup& soup, int f,
+                                  FacetGeometry* geo, double far = 0) {
   const int* const v = soup.vertex.data() + soup.begin[f];
   const int* const w = v + Degree;  // facet f + 1's corners follow f's
   const auto load = [&](int k) {
     const V3<double>&p = points[v[k]], &q = points[w[k]];
     return V3<Pair>{Pair{p.x, q.x}, Pair{p.y, q.y}, Pair{p.z, q.z}};
   };
-  const Pair zero{0, 0};
-  const V3<Pair> origin = load(0), q1 = load(1) - origin, q2 = load(2) - origin;
+  const auto squared = [](const V3<Pair>& p, const V3<Pair>& q) {
+    const V3<Pair> d = p - q;
+    return dot(d, d);
+  };
+  const Pair zero{0, 0}, bound{far, far};
+  const V3<Pair> origin = load(0), p1 = load(1), p2 = load(2);
+  const V3<Pair> q1 = p1 - origin, q2 = p2 - origin;
+  const Pair s1 = dot(q1, q1), s2 = dot(q2, q2);
+  auto near = (s1 <= bound) | (s2 <= bound) | (squared(p1, p2) <= bound);
   V3<Pair> sum, centroid;
   Pair longest_squared;
   if constexpr (Degree == 3) {
     sum = plus_zero(cross(q1, q2));
     const V3<Pair> e = q2 - q1;
-    longest_squared = pair_max(pair_max(pair_max(zero, dot(q1, q1)), dot(e, e)), dot(q2, q2));
+    longest_squared = pair_max(pair_max(pair_max(zero, s1), dot(e, e)), s2);
     centroid = plus_zero(q1) + q2;
   } else {
-    const V3<Pair> q3 = load(3) - origin;
+    const V3<Pair> p3 = load(3);
+    const V3<Pair> q3 = p3 - origin;
+    const Pair s3 = dot(q3, q3);
+    near |= (s3 <= bound) | (squared(p1, p3) <= bound) | (squared(p2, p3) <= bound);
     sum = plus_zero(cross(q1, q2)) + cross(q2, q3);
     const V3<Pair> e1 = q2 - q1, e2 = q3 - q2;
-    longest_squared = pair_max(
-        pair_max(pair_max(pair_max(zero, dot(q1, q1)), dot(e1, e1)), dot(e2, e2)), dot(q3, q3));
+    longest_squared =
+        pair_max(pair_max(pair_max(pair_max(zero, s1), dot(e1, e1)), dot(e2, e2)), s3);
     centroid = (plus_zero(q1) + q2) + q3;
   }
+  const auto repeated = [](const int* u) {
+    if constexpr (Degree == 3) return (u[0] == u[1]) | (u[0] == u[2]) | (u[1] == u[2]);
+    return (u[0] == u[1]) | (u[0] == u[2]) | (u[0] == u[3]) | (u[1] == u[2]) | (u[1] == u[3]) |
+           (u[2] == u[3]);
+  };
+  const std::array<bool, 2> apart{!(near[0] | repeated(v)), !(near[1] | repeated(w))};
   const Pair squared_area = dot(sum, sum);
   if (!(squared_area[0] <= kLargest) || !(squared_area[1] <= kLargest)) {
     for (int g = f; g < f + 2; ++g)
       geo[g] = Degree == 3 ? triangle_geometry(points, soup, g) : quad_geometry(points, soup, g);
-    return;
+    return apart;
   }
   const Pair longest = pair_sqrt(longest_squared), area = pair_sqrt(squared_area);
   const V3<Pair> normal{sum.x / area, sum.y / area, sum.z / area};
@@ -417,6 +437,7 @@ void geometry_pair(const std::vector<V3<double>>& points, const Soup& soup, int 
       g.offset = offset[i];
     }
   }
+  return apart;
 }
 
 bool is_thin(const FacetGeometry& g, double limit) {
@@ -443,29 +464,33 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
   std::vector<int> reference(nf), last_member(nf);
   std::iota(reference.begin(), reference.end(), 0);
   std::iota(last_member.begin(), last_member.end(), 0);
+  // Plain pointers: loaded once, not through the captures for each test.
+  const V3<double>* const point = points.data();
+  const int *const vertex = soup.vertex.data(), *const begin = soup.begin.data();
+  // All vertices of facet `g`, a group alone, within `limit` of the plane of facet `ref`;
+  // `edge`: g's corner on the edge that the two share. Its corners from the one after the
+  // shared edge on, as the edge's ends are on the plane when the groups already meet
+  // there. Which corner fails first does not change the answer.
+  const auto holds_alone = [=](int ref, int g, int edge) {
+    const FacetGeometry& p = geo[ref];
+    if (is_thin(p, limit)) return false;
+    // A facet's corners are consecutive (next is the one after, or the first after the
+    // last): found so rather than through `next`, whose loads would delay the first test.
+    const int b = begin[g], e = begin[g + 1], d = e - b;
+    int c = edge + 2 >= e ? edge + 2 - d : edge + 2;  // d >= 3
+    for (int i = 0; i < d; ++i, c = c + 1 == e ? b : c + 1)
+      if (std::abs(dot(p.normal, point[vertex[c]]) - p.offset) > limit) return false;
+    return true;
+  };
   // All vertices of group `g` within `limit` of the plane of facet `ref`; `edge`: g's corner
   // on the edge that the two groups share.
   auto holds = [&](int ref, int g, int edge) {
+    if (next_member[g] < 0) return holds_alone(ref, g, edge);  // one facet, named by it
     const FacetGeometry& p = geo[ref];
     if (is_thin(p, limit)) return false;
-    const auto off = [&](int c) {
-      return std::abs(dot(p.normal, points[soup.vertex[c]]) - p.offset) > limit;
-    };
-    if (next_member[g] < 0) {
-      // One facet (the group is named by it, and has the edge): its corners from the one
-      // after the shared edge on, as the edge's ends are on the plane when the groups
-      // already meet there. Which corner fails first does not change the answer.
-      // A facet's corners are consecutive (next is the one after, or the first after the
-      // last): found so rather than through `next`, whose loads would delay the first test.
-      const int b = soup.begin[g], e = soup.begin[g + 1], d = e - b;
-      int c = edge + 2 >= e ? edge + 2 - d : edge + 2;  // d >= 3
-      for (int i = 0; i < d; ++i, c = c + 1 == e ? b : c + 1)
-        if (off(c)) return false;
-      return true;
-    }
     for (int f = g; f >= 0; f = next_member[f])
-      for (int c = soup.begin[f]; c < soup.begin[f + 1]; ++c)
-        if (off(c)) return false;
+      for (int c = begin[f]; c < begin[f + 1]; ++c)
+        if (std::abs(dot(p.normal, point[vertex[c]]) - p.offset) > limit) return false;
     return true;
   };
   const int nc = static_cast<int>(soup.vertex.size());
@@ -490,7 +515,8 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
           std::swap(a, b);
           edge_b = c;
         }
-        if (a != b && holds(a, b, edge_b)) passed[block].push_back(c);
+        // (Every facet is alone before the joins.)
+        if (a != b && holds_alone(a, b, edge_b)) passed[block].push_back(c);
       }
   });
   std::vector<char> alone(nf, 1);
@@ -894,6 +920,7 @@ void geometries(const std::vector<V3<double>>& points, const Soup& soup, FacetGe
 /// What pass 2 starts from: the soup's connectivity (nothing when it is not a closed
 /// manifold) and its facets' geometry, when they were found beforehand (`geo` set).
 struct Prepared {
+  bool connected = false;  // whether `k` was looked for
   std::optional<Connectivity> k;
   std::unique_ptr<FacetGeometry[]> geo;
 };
@@ -920,6 +947,8 @@ std::optional<std::pair<Soup, Connectivity>> simplify(const std::vector<V3<doubl
       k = connect(static_cast<int>(points.size()), soup);
       if (k) geometries(points, soup, pre.geo.get());
     }
+  } else if (!pre.connected) {
+    k = connect(static_cast<int>(points.size()), soup);
   }
   if (!k) return std::nullopt;
   const FacetGeometry* const geo = pre.geo.get();
@@ -1273,10 +1302,10 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
   soup.begin = face_begin;
   soup.vertex = std::move(facet_corners);
   const std::vector<int>& corners = soup.vertex;
-  // With threads to spare, the soup's connectivity and its facets' geometry (pass 2's
-  // input) are found beside pass 1, on the chance that the facets are the soup as they
-  // are (rather than `simplify` splitting each into chunks too short to pay at a few
-  // thousand facets). They are dropped if not.
+  // The facets' geometry (pass 2's input) is found in pass 1's search, from the points it
+  // loads, on the chance that the facets are the soup as they are; with threads to spare,
+  // so is the soup's connectivity, beside pass 1 (rather than `simplify` splitting each
+  // into chunks too short to pay at a few thousand facets). They are dropped if not.
   const bool ahead = nf >= kFacetGrain && tbb::this_task_arena::max_concurrency() > 1;
   Prepared pre;
   UnionFind clusters(n);
@@ -1286,10 +1315,22 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
   const auto find_close = [&] {
     V3<double> lo{0, 0, 0}, hi{0, 0, 0};
     if (n > 0) lo = hi = points[0];
-    for (const auto& p : points) {
-      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+    // The even and odd points in two boxes (half as long chains of dependent minima), then
+    // joined: the same extremes (a NaN enters only as points[0]'s, in both; which zero is
+    // kept may differ, and neither the span nor the magnitude below depends on it).
+    V3<double> lo_odd = lo, hi_odd = hi;
+    const auto extend = [](V3<double>& low, V3<double>& high, const V3<double>& p) {
+      low = {std::min(low.x, p.x), std::min(low.y, p.y), std::min(low.z, p.z)};
+      high = {std::max(high.x, p.x), std::max(high.y, p.y), std::max(high.z, p.z)};
+    };
+    int v = 0;
+    for (; v + 1 < n; v += 2) {
+      extend(lo, hi, points[v]);
+      extend(lo_odd, hi_odd, points[v + 1]);
     }
+    if (v < n) extend(lo, hi, points[v]);
+    extend(lo, hi, lo_odd);
+    extend(lo, hi, hi_odd);
     const V3<double> span = hi - lo;
     limit = kFeatureTolerance * std::sqrt(dot(span, span));
     // Points whose rounding unit exceeds the feature size (a result far from the origin for
@@ -1352,16 +1393,39 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
     // unions below are those of close corners either way.
     std::vector<char> has_close(nf, 0);
     std::atomic<bool> some_close{false};
+    // Whether a facet has fewer than three corners or is compared by its sides alone (the
+    // facets taken two at a time have three or four).
+    std::atomic<bool> some_irregular{false};
     parallel_chunks(nf, kFacetGrain, [&](int first, int last) {
-      bool found = false;
-      for (int f = first; f < last; ++f) {
+      bool found = false, irregular = false;
+      const auto test = [&](int f, bool apart) {
         bool here = false;
-        if (!surely_apart(f))
-          for_pairs(f, [&](int u, int w) { here = here || u == w || close(u, w); });
+        if (!apart) for_pairs(f, [&](int u, int w) { here = here || u == w || close(u, w); });
         has_close[f] = here;
         found = found || here;
+      };
+      FacetGeometry* const geo = pre.geo.get();
+      for (int f = first; f < last; ++f) {
+        // Two facets of one degree at once when they follow each other (nearly all), with
+        // their geometry from the same points.
+        const int d = face_begin[f + 1] - face_begin[f];
+        if (f + 1 < last && (d == 3 || d == 4) && face_begin[f + 2] - face_begin[f + 1] == d) {
+          const std::array<bool, 2> apart = d == 3 ? geometry_pair<3>(points, soup, f, geo, far)
+                                                   : geometry_pair<4>(points, soup, f, geo, far);
+          test(f, apart[0]);
+          test(f + 1, apart[1]);
+          ++f;
+          continue;
+        }
+        if (d >= 3)  // (a facet of fewer corners is not the soup's)
+          geo[f] = d == 3   ? triangle_geometry(points, soup, f)
+                   : d == 4 ? quad_geometry(points, soup, f)
+                            : geometry(points, soup, f);
+        test(f, surely_apart(f));
+        irregular = irregular || d < 3 || d > kPairwiseDegree;
       }
       if (found) some_close.store(true, std::memory_order_relaxed);
+      if (irregular) some_irregular.store(true, std::memory_order_relaxed);
     });
     any_close = some_close.load();
     if (any_close)
@@ -1375,7 +1439,8 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
     // have one (the others would have been marked above).
     bool given = !any_close;      // a local: `as_given` is the caller's
     std::vector<int> last_facet;  // the last facet a point was seen in, to find repeats
-    for (int f = 0; f < nf && given; ++f) {
+    const bool irregular = some_irregular.load();  // else every facet passes the loop below
+    for (int f = 0; f < nf && given && irregular; ++f) {
       const int b = face_begin[f], e = face_begin[f + 1];
       given = e - b >= 3;
       if (e - b <= kPairwiseDegree) continue;
@@ -1386,15 +1451,14 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
       }
     }
     as_given = given;
-    if (ahead && as_given) {
-      pre.geo = std::make_unique_for_overwrite<FacetGeometry[]>(nf);
-      geometries(points, soup, pre.geo.get());
-    }
   };
-  if (ahead)
+  pre.geo = std::make_unique_for_overwrite<FacetGeometry[]>(nf);
+  if (ahead) {
     run_both(find_close, [&] { pre.k = connect(n, soup); });
-  else
+    pre.connected = true;
+  } else {
     find_close();
+  }
   bool repeated = false;
   if (as_given) {
     soup.source.resize(nf);
