@@ -642,6 +642,8 @@ class OnceFlags {
   bool done(std::size_t i) const {
     return state_[i].load(std::memory_order_acquire) == once_state::kDone;
   }
+  /// Marks i done, before any call (its value made by the owner meanwhile).
+  void set_done(std::size_t i) { state_[i].store(once_state::kDone, std::memory_order_relaxed); }
 
  private:
   std::unique_ptr<std::atomic<unsigned char>[]> state_;  // value-initialised: kNone
@@ -652,8 +654,21 @@ class OnceFlags {
 /// Shared by every stage of an intersection: the flips, each check, the incremental hull.
 class PrecisePlanes {
  public:
+  /// The copies of planes with both double-double copies (HalfSpace::normal_dd, offset_dd)
+  /// are made here, in order: a few operations on values read by then, where made on first
+  /// use they cost a cache miss on the half-space each (scattered, and large).
   explicit PrecisePlanes(const std::vector<Plane>& planes)
-      : planes_(planes), precise_(planes.size()), once_(planes.size()) {}
+      : planes_(planes), precise_(planes.size()), once_(planes.size()) {
+    parallel_chunks(static_cast<int>(planes.size()), 512, [&](int begin, int end) {
+      CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+      for (int i = begin; i < end; ++i) {
+        const HalfSpace* h = planes[i].source;
+        if (!h || !h->has_normal_dd || !h->has_offset_dd) continue;
+        precise_[i] = precise_plane(planes[i]);
+        once_.set_done(i);
+      }
+    });
+  }
   const PrecisePlane& operator[](int i) const {  // any rounding mode
     once_.call(i, [&] {
       CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
