@@ -560,6 +560,43 @@ TEST_CASE("polytope: two triangles a hair from coplanar stay apart when convex, 
 
 namespace {
 
+// The box [0, 2] x [0, 1] x [-1, 0] with its top split into two quadrilaterals along x = 1, that
+// edge (vertices 5 and 8) raised by eps (at z = 0, so that a tiny eps is kept): the front and
+// back stay planar pentagons.
+Mesh bent_box(double eps) {
+  const std::vector<Point> points = {
+      Point(0, 0, -1),  Point(2, 0, -1), Point(2, 1, -1), Point(0, 1, -1),  Point(0, 0, 0),
+      Point(1, 0, eps), Point(2, 0, 0),  Point(0, 1, 0),  Point(1, 1, eps), Point(2, 1, 0)};
+  return morph::test::mesh_from_polygons(points, {{0, 3, 2, 1},
+                                                  {0, 1, 6, 5, 4},
+                                                  {3, 7, 8, 9, 2},
+                                                  {0, 4, 7, 3},
+                                                  {1, 2, 9, 6},
+                                                  {4, 5, 8, 7},
+                                                  {5, 6, 9, 8}});
+}
+
+}  // namespace
+
+TEST_CASE(
+    "polytope: two quadrilaterals a hair from coplanar stay apart when convex, merge when not") {
+  // finish_from_halfedges tests a quadrilateral's edges and turns on the unit normals, two
+  // corners at once, and leaves what they do not decide to is_canonical and check_gauss_map: a
+  // ridge (eps > 0) stays two facets, a valley (eps < 0, convex within the tolerance) is merged
+  // and its two vertices removed, whichever stage decides.
+  for (const double eps : {0x1p-20, 0x1p-45, 0x1p-60, 0.0, -0x1p-45, -0x1p-60}) {
+    CAPTURE(eps);
+    const Mesh mesh = bent_box(eps);
+    REQUIRE(morph::check_convex_polyhedron(mesh).ok());
+    const Polytope p = morph::detail::make_operand(mesh, "A");
+    CHECK(p.num_faces() == (eps > 0 ? 7 : 6));
+    CHECK(p.num_vertices() == (eps > 0 ? 10 : 8));
+    check_both_paths(mesh, "bent box");
+  }
+}
+
+namespace {
+
 // make_operand's check proves every edge of a triangle mesh strictly convex from the heights of
 // its reflex test (validate.cpp, StrictBelow), and the build then skips is_canonical()'s test of
 // the edges: the proof must hold exactly whenever it is given, and never be given for a flat

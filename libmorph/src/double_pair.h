@@ -59,4 +59,26 @@ inline bool both_at_most(Pair h, Pair bound) {
 #endif
 }
 
+/// {a[1], b[0]}: the high lane of a and the low lane of b (one instruction), for values that
+/// run on from one pair into the next.
+inline Pair pair_high_low(Pair a, Pair b) {
+#if defined(__SSE2__)
+  return _mm_shuffle_pd(a, b, 1);
+#else
+  return Pair{a[1], b[0]};
+#endif
+}
+
+/// The lanes of a comparison of Pairs (a > b and so on: all bits set where it holds).
+using PairMask = decltype(Pair{} > Pair{});
+
+/// Whether both lanes of a comparison's mask hold.
+inline bool both_true(PairMask mask) {
+#if defined(__SSE2__)
+  return _mm_movemask_pd(reinterpret_cast<__m128d>(mask)) == 3;
+#else
+  return mask[0] != 0 && mask[1] != 0;
+#endif
+}
+
 }  // namespace morph::detail

@@ -14,6 +14,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "double_pair.h"
 #include "parallel.h"
 #include "union_find.h"
 #include "validate_detail.h"
@@ -747,12 +748,18 @@ void check_edges_convex(const Polytope& p, const char* name) {
                      std::to_string(p.vertex_source[e.to]) + " is not convex");
 }
 
+/// Whether every vertex has at least three facets.
+bool fans_at_least_three(const Polytope& p) {
+  for (int v = 0; v < p.num_vertices(); ++v)
+    if (p.fan_begin[v + 1] - p.fan_begin[v] < 3) return false;
+  return true;
+}
+
 /// Whether every edge is strictly convex and every vertex has at least three facets:
 /// then the polytope is canonical as it is (nothing to merge or remove). `edges_convex`: every
 /// edge is known to be strictly convex (make_operand's check proved it, see geometry_passes).
 bool is_canonical(const Polytope& p, bool edges_convex = false) {
-  for (int v = 0; v < p.num_vertices(); ++v)
-    if (p.fan_begin[v + 1] - p.fan_begin[v] < 3) return false;
+  if (!fans_at_least_three(p)) return false;
   if (edges_convex) return true;
   RoundingGuard guard;
   for (const auto& e : p.edges) {
@@ -761,6 +768,124 @@ bool is_canonical(const Polytope& p, bool edges_convex = false) {
     if (s < 0 || (s == 2 && edge_convexity(p, e) <= 0)) return false;
   }
   return true;
+}
+
+/// edges_and_turns_pass() of one quadrilateral y (corners p0..p3, a_k across its edge from p_k
+/// to p_(k+1)), two corners in the lanes of each Pair: the same tests with the same bounds (each
+/// lane does one corner's operations, in any rounding mode). The turns at all four corners; the
+/// edges of corners 0 and 1, and those of corners 2 and 3 only with `last_edges`.
+inline bool quad_edges_and_turns_pass(const UnitNormal& y, const UnitNormal& a0,
+                                      const UnitNormal& a1, const UnitNormal& a2,
+                                      const UnitNormal& a3, const V3<double>& p0,
+                                      const V3<double>& p1, const V3<double>& p2,
+                                      const V3<double>& p3, bool last_edges) {
+  const Pair yx{y.x, y.x}, yy{y.y, y.y}, yz{y.z, y.z}, ye{y.error, y.error};
+  // Corners 0, 1 in one pair, 2, 3 in the other.
+  const Pair ax{a0.x, a1.x}, ay{a0.y, a1.y}, az{a0.z, a1.z}, ae{a0.error, a1.error};
+  const Pair bx{a2.x, a3.x}, by{a2.y, a3.y}, bz{a2.z, a3.z}, be{a2.error, a3.error};
+  // c_k = N_y x N_a_k.
+  const Pair cx = yy * az - yz * ay, cy = yz * ax - yx * az, cz = yx * ay - yy * ax;
+  const Pair dx = yy * bz - yz * by, dy = yz * bx - yx * bz, dz = yx * by - yy * bx;
+  // The turns at corners 0, 1 read c_3, c_0; at corners 2, 3, c_1, c_2.
+  const Pair k = {kUnitPredicateRounding, kUnitPredicateRounding};
+  const Pair turn_a =
+      ax * pair_high_low(dx, cx) + ay * pair_high_low(dy, cy) + az * pair_high_low(dz, cz);
+  const Pair turn_b =
+      bx * pair_high_low(cx, dx) + by * pair_high_low(cy, dy) + bz * pair_high_low(cz, dz);
+  PairMask ok = (turn_a > ae + ye + pair_high_low(be, ae) + k) &
+                (turn_b > be + ye + pair_high_low(ae, be) + k);
+  // The edges p0-p1, p1-p2 (and p2-p3, p3-p0), with unit_edge_convexity's bound.
+  const auto edges_pass = [&](const V3<double>& q0, const V3<double>& q1, const V3<double>& q2,
+                              Pair nx, Pair ny, Pair nz, Pair error) {
+    const Pair ux = Pair{q1.x, q2.x} - Pair{q0.x, q1.x}, uy = Pair{q1.y, q2.y} - Pair{q0.y, q1.y},
+               uz = Pair{q1.z, q2.z} - Pair{q0.z, q1.z};
+    const Pair length = pair_abs(ux) + pair_abs(uy) + pair_abs(uz);
+    const Pair ulp = {0x1p-52 * 1.01, 0x1p-52 * 1.01}, margin = {1.01, 1.01};
+    const Pair tiny = {1e-250, 1e-250}, huge = {1e250, 1e250};
+    return (length > tiny) & (length < huge) &
+           (ux * nx + uy * ny + uz * nz > ((ye + error + k) * length + length * ulp) * margin);
+  };
+  ok &= edges_pass(p0, p1, p2, cx, cy, cz, ae);
+  if (last_edges) ok &= edges_pass(p2, p3, p0, dx, dy, dz, be);
+  return both_true(ok);
+}
+
+/// is_canonical's edge test and check_gauss_map's turns at once, walking the facets, on the
+/// double filters alone: true when every edge of p (double points, unit normals computed) is
+/// shown strictly convex by unit_edge_convexity's filter and every turn of the Gauss map shown
+/// positive by orient_normals' filter; false when any is not shown (the caller then runs the two
+/// checks themselves, which decide it and name what fails). With the facet y, the facet a_k
+/// across its edge from corner k to corner k + 1, and c_k = N_y x N_a_k (one cross product per
+/// corner, shared by the two tests):
+///  - the edge: det(N_y, N_a_k, p_(k+1) - p_k) = d_k . c_k, the same determinant whichever facet
+///    holds the edge from -> to (from the other side both the normals and the direction swap),
+///    with unit_edge_convexity's bound; each edge is tested from its facet of smaller index at
+///    least (a quadrilateral skips two of the others, other facets test all theirs);
+///  - the turn at corner k (vertex v): in v's fan, the facet before y is the one across y's edge
+///    leaving v (a_k), the one after it across the edge entering v (a_(k-1)), so the turn is
+///    det(a_k, y, a_(k-1)) = a_k . c_(k-1), with orient_normals' bound; every corner is the
+///    middle of one turn, so this covers every turn.
+/// Both bounds hold in any rounding mode.
+/// `across_ending`, when given: the facet across the edge that ends at each corner
+/// (OperandTopology's), read instead of the edges.
+bool edges_and_turns_pass(const Polytope& p, const int* across_ending = nullptr) {
+  const UnitNormal* const unit = p.unit_normals.data();
+  const V3<double>* const points = p.points.data();
+  const int* const face_begin = p.face_begin.data();
+  const int* const corner_vertex = p.corner_vertex.data();
+  const int* const corner_edge = p.corner_edge.data();
+  const Polytope::Edge* const edges = p.edges.data();
+  bool pass = true;
+  for (int f = 0, nf = p.num_faces(); f < nf; ++f) {
+    const int b = face_begin[f], n = face_begin[f + 1] - b;
+    const UnitNormal y = unit[f];
+    // The facet across the edge from corner c to the next: the one across the edge that ends
+    // at the next corner.
+    const auto across = [&](int c) {
+      if (across_ending) return across_ending[c + 1 < b + n ? c + 1 : b];
+      const Polytope::Edge& e = edges[corner_edge[c]];
+      return e.left ^ e.right ^ f;
+    };
+    if (n == 4) {
+      const int a[4] = {across(b), across(b + 1), across(b + 2), across(b + 3)};
+      // Each edge is tested from its facet of smaller index at least (both sides give the same
+      // determinant): when those this facet tests are two corners that follow each other, they
+      // are put first and the other two corners' edges are not tested.
+      const unsigned own =
+          static_cast<unsigned>(f <= a[0]) | (f <= a[1]) << 1 | (f <= a[2]) << 2 | (f <= a[3]) << 3;
+      const int r = (own & 0b1100) == 0 ? 0 : (own & 0b1001) == 0 ? 1 : (own & 0b0011) == 0 ? 2 : 3;
+      const bool last_edges = r == 3 && (own & 0b0110) != 0;
+      pass &= quad_edges_and_turns_pass(y, unit[a[r]], unit[a[(r + 1) & 3]], unit[a[(r + 2) & 3]],
+                                        unit[a[(r + 3) & 3]], points[corner_vertex[b + r]],
+                                        points[corner_vertex[b + ((r + 1) & 3)]],
+                                        points[corner_vertex[b + ((r + 2) & 3)]],
+                                        points[corner_vertex[b + ((r + 3) & 3)]], last_edges);
+      continue;
+    }
+    // c_(k-1) and its facet's error, from the last corner's edge.
+    const UnitNormal& last = unit[across(b + n - 1)];
+    double cx = y.y * last.z - y.z * last.y, cy = y.z * last.x - y.x * last.z,
+           cz = y.x * last.y - y.y * last.x, previous_error = last.error;
+    V3<double> from = points[corner_vertex[b]];
+    for (int k = 0; k < n; ++k) {
+      const UnitNormal& a = unit[across(b + k)];
+      const double turn = a.x * cx + a.y * cy + a.z * cz;
+      pass &= turn > a.error + y.error + previous_error + kUnitPredicateRounding;
+      cx = y.y * a.z - y.z * a.y;
+      cy = y.z * a.x - y.x * a.z;
+      cz = y.x * a.y - y.y * a.x;
+      previous_error = a.error;
+      const V3<double> to = points[corner_vertex[k + 1 < n ? b + k + 1 : b]];
+      const V3<double> d = to - from;
+      from = to;
+      const double length = std::abs(d.x) + std::abs(d.y) + std::abs(d.z);
+      const double radius = length * 0x1p-52 * 1.01;
+      const double value = d.x * cx + d.y * cy + d.z * cz;
+      pass &= length > 1e-250 && length < 1e250 &&
+              value > ((y.error + a.error + kUnitPredicateRounding) * length + radius) * 1.01;
+    }
+  }
+  return pass;
 }
 
 /// The rest of check_operand's topological checks on a mesh whose halfedges
@@ -1193,13 +1318,17 @@ namespace {
 /// edges and fans: the normals, the canonical form, the labels and the Gauss map. The facet
 /// cycles are only read (they end in the result, or stay in p).
 /// `units_known`: p.unit_normals already holds the facets' unit normals; `edges_convex`: and
-/// every edge is known to be strictly convex.
+/// every edge is known to be strictly convex. `across`, when given: OperandTopology's (the facet
+/// across the edge that ends at each corner).
 Polytope finish_from_halfedges(Polytope& p, std::vector<int> mesh_edge, const Mesh& mesh,
                                const char* name, FaceOrder order, bool units_known = false,
-                               bool edges_convex = false) {
+                               bool edges_convex = false, const int* across = nullptr) {
   p.compute_normals(units_known);
-  if (!is_canonical(p, units_known && edges_convex))
-    return make_polytope_from_cycles(mesh, name, order);
+  // The edges and turns on their filters in one pass where the check did not prove them; the
+  // two checks themselves otherwise (or when the filters leave any undecided).
+  const bool proven = units_known && edges_convex;
+  const bool passes = !proven && fans_at_least_three(p) && edges_and_turns_pass(p, across);
+  if (!passes && !is_canonical(p, proven)) return make_polytope_from_cycles(mesh, name, order);
   p.vertex_source.resize(p.num_vertices());
   std::iota(p.vertex_source.begin(), p.vertex_source.end(), 0);
   p.face_source.resize(p.num_faces());
@@ -1207,7 +1336,7 @@ Polytope finish_from_halfedges(Polytope& p, std::vector<int> mesh_edge, const Me
   p.edge_source = std::move(mesh_edge);
   // Every edge is strictly convex (is_canonical); the Gauss map is left to check, where
   // that does not already prove it (turns through three triangles).
-  check_gauss_map(p, name, true);
+  if (!passes) check_gauss_map(p, name, true);
   return std::move(p);
 }
 
@@ -1275,7 +1404,7 @@ std::optional<Polytope> checked_polytope(const Mesh& mesh, const char* name) {
     if (rejected) return;
     try {
       built = finish_from_halfedges(p, std::move(mesh_edge), mesh, name, FaceOrder::as_given,
-                                    units_known, edges_convex);
+                                    units_known, edges_convex, topology.across.data());
     } catch (...) {
       build_error = std::current_exception();
     }
