@@ -10,9 +10,11 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <numeric>
 #include <random>
 #include <string>
+#include <thread>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -558,7 +560,7 @@ TEST_CASE("normal predicates: the double-double stage alone agrees with exact ev
           CHECK(n.exactly_zero(i) == (CGAL::sign(i == 0 ? x.x : i == 1 ? x.y : x.z) == 0));
       }
     int tested = 0, decided = 0, zero = 0, zero_decided = 0, tiny = 0, tiny_decided = 0;
-    int tested_cross = 0, decided_cross = 0;
+    int tested_cross = 0, decided_cross = 0, full_decided = 0;
     std::vector<int> order(B.num_faces());
     for (int f = 0; f < A.num_faces(); ++f) {
       const NormalRef a{&A, f};
@@ -588,6 +590,10 @@ TEST_CASE("normal predicates: the double-double stage alone agrees with exact ev
               all = all && s != morph::detail::kUndecided;
               ++tested;
               decided += s != morph::detail::kUndecided;
+              // Without the pair's step (orient_undecided's entry after a kept product).
+              const int full = morph::detail::orient_normals_precise_full(x, y, z);
+              if (full != morph::detail::kUndecided) CHECK(full == sign * exact);
+              full_decided += full != morph::detail::kUndecided;
             }
             // (x x y) . (z x t) in the forms between() evaluates on such triples, and with
             // the nearly parallel pair second.
@@ -612,12 +618,47 @@ TEST_CASE("normal predicates: the double-double stage alone agrees with exact ev
                       << " nonzero below the double filter (" << tiny_decided << " decided); "
                       << tested_cross << " of cross_dot, " << decided_cross << " decided");
     CHECK(decided > 0);
+    CHECK(full_decided > 0);
     CHECK(decided_cross > 0);
     if (pair.degenerate) {
       CHECK(zero_decided > 0);
       CHECK(tiny_decided > 0);
     }
   }
+}
+
+// Precise normals are made on first use in one flat array per polytope: threads racing for
+// the same facets must all read the values one thread alone makes, bit for bit.
+TEST_CASE("normal predicates: precise normals made by racing threads are a lone thread's") {
+  const Mesh ico = sample("icosphere_1280.off");
+  const Polytope alone = morph::detail::make_operand(ico, "alone");
+  const Polytope shared = morph::detail::make_operand(ico, "shared");
+  constexpr int kThreads = 4;
+  std::vector<std::vector<morph::detail::PreciseNormal>> seen(kThreads);
+  {
+    std::vector<std::thread> threads;
+    for (int t = 0; t < kThreads; ++t)
+      threads.emplace_back([&, t] {
+        // Different orders, so that threads meet on slots being written.
+        for (int i = 0; i < shared.num_faces(); ++i) {
+          const int f = t % 2 == 0 ? i : shared.num_faces() - 1 - i;
+          seen[t].push_back(shared.precise_normal(f));
+        }
+      });
+    for (auto& thread : threads) thread.join();
+  }
+  auto same = [](const morph::detail::PreciseNormal& x, const morph::detail::PreciseNormal& y) {
+    return std::memcmp(x.hi, y.hi, sizeof x.hi) == 0 && std::memcmp(x.lo, y.lo, sizeof x.lo) == 0 &&
+           std::memcmp(x.error, y.error, sizeof x.error) == 0 && x.valid == y.valid;
+  };
+  int differing = 0;
+  for (int t = 0; t < kThreads; ++t)
+    for (int i = 0; i < alone.num_faces(); ++i) {
+      const int f = t % 2 == 0 ? i : alone.num_faces() - 1 - i;
+      const auto& y = alone.precise_normal(f);
+      differing += !same(seen[t][i], y) || !same(shared.precise_normal(f), y);
+    }
+  CHECK(differing == 0);
 }
 
 // two_prod takes a fused multiply-subtract where the processor has one (kHasFma): its doubles

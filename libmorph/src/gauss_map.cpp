@@ -257,9 +257,10 @@ bool near_cross(const NormalRef& x, const NormalRef& y, double w[3], double& eps
 /// cross product from `pairs` (undecided for a pair not of the scope's polytopes). Undecided
 /// where that stage is not tried (a component that may be zero in all three: the determinant
 /// may be zero, which only the later stages show; trying this stage first there measured
-/// slower).
+/// slower). `tried`: set when this stage ran (decided or not), so that the caller skips
+/// orient_normals_precise's repetition of it.
 int orient_near_cached(NearPairs& pairs, const NormalRef& a, const NormalRef& b,
-                       const NormalRef& c) {
+                       const NormalRef& c, bool& tried) {
   const UnitNormal &ua = a.unit(), &ub = b.unit(), &uc = c.unit();
   auto may_be_zero = [](double pa, double pb, double pc, double ea, double eb, double ec) {
     return std::abs(pa) <= ea && std::abs(pb) <= eb && std::abs(pc) <= ec;
@@ -282,7 +283,9 @@ int orient_near_cached(NearPairs& pairs, const NormalRef& a, const NormalRef& b,
   else
     x = &c, y = &a, z = &ub;
   auto kept = [&pairs](const Polytope* P) { return P == pairs.a || P == pairs.b; };
-  if (!std::isfinite(z->error) || !kept(x->polytope) || !kept(y->polytope)) return kUndecided;
+  if (!kept(x->polytope) || !kept(y->polytope)) return kUndecided;
+  tried = true;
+  if (!std::isfinite(z->error)) return kUndecided;
   const unsigned hash = (static_cast<unsigned>(x->face) * 0x9E3779B1u) ^
                         (static_cast<unsigned>(y->face) * 0x85EBCA77u);
   NearPairs::Entry& e = pairs.entries[(hash >> 16) & (NearPairs::kSize - 1)];
@@ -319,11 +322,13 @@ int orient_undecided(const NormalRef& a, const NormalRef& b, const NormalRef& c,
           ? same_normal(a, c) || same_normal(b, c)
           : (same_unit(a, c) && same_normal(a, c)) || (same_unit(b, c) && same_normal(b, c)))
     return 0;
+  bool tried = false;
   if (near_pairs) {
-    const int s = orient_near_cached(*near_pairs, a, b, c);
+    const int s = orient_near_cached(*near_pairs, a, b, c, tried);
     if (s != kUndecided) return s;
   }
-  const int s = orient_normals_precise(a, b, c);
+  // The pair's step again would give the same (exact signs, whichever rounding mode).
+  const int s = tried ? orient_normals_precise_full(a, b, c) : orient_normals_precise(a, b, c);
   if (s != kUndecided) return s;
   if (same_normal(a, c) || same_normal(b, c) || same_normal(a, b)) return 0;
   return orient_normals_exact(a, b, c);

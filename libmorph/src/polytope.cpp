@@ -281,7 +281,7 @@ void Polytope::compute_normals(bool units_known) {
     }
   }
   exact_cache_ = std::make_shared<LazySlots<V3<ExactN>>>(nf);
-  precise_cache_ = std::make_shared<LazySlots<PreciseNormal>>(nf);
+  precise_cache_ = std::make_shared<FlatSlots<PreciseNormal>>(nf);
 }
 
 int orient_normals_undecided(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
@@ -382,6 +382,44 @@ int cross_dot_near_pair(const NormalRef& x, const NormalRef& y, const UnitNormal
 
 }  // namespace
 
+namespace {
+
+/// orient_normals_precise's last stage: det in double-double on the three precise normals
+/// (round-to-nearest: the caller's guard).
+int orient_full_stage(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
+  const PreciseNormal& p = a.polytope->precise_normal(a.face);
+  const PreciseNormal& q = b.polytope->precise_normal(b.face);
+  const PreciseNormal& r = c.polytope->precise_normal(c.face);
+  if (p.valid && q.valid && r.valid) {
+    // Three normals with the same zero component lie in one plane.
+    for (int i = 0; i < 3; ++i)
+      if (p.exactly_zero(i) && q.exactly_zero(i) && r.exactly_zero(i)) return 0;
+    auto dd = [](const PreciseNormal& n, int i) { return DD{n.hi[i], n.lo[i]}; };
+    auto minor = [&](int i, int j) { return dd(q, i) * dd(r, j) - dd(q, j) * dd(r, i); };
+    const DD value = dd(p, 0) * minor(1, 2) + dd(p, 1) * minor(2, 0) + dd(p, 2) * minor(0, 1);
+    // The evaluation: three levels of operations on terms bounded by the permanent.
+    double permanent = 0;
+    for (int i = 0; i < 3; ++i) {
+      const int j = (i + 1) % 3, l = (i + 2) % 3;
+      permanent +=
+          std::abs(p.hi[i]) * (std::abs(q.hi[j] * r.hi[l]) + std::abs(q.hi[l] * r.hi[j]));
+    }
+    // The inputs: det moves by at most |da| |b| |c| + |a'| |db| |c| + |a'| |b'| |dc|, with
+    // x' = x + dx.
+    const double la = length_bound(p), lb = length_bound(q), lc = length_bound(r);
+    const double da = error_bound(p), db = error_bound(q), dc = error_bound(r);
+    const double bound = (da * lb * lc + (la + da) * db * lc + (la + da) * (lb + db) * dc +
+                          64 * kU2 * permanent * 1.1) *
+                             1.01 +
+                         0x1p-1000;
+    if (value.hi > bound) return 1;
+    if (value.hi < -bound) return -1;
+  }
+  return kUndecided;
+}
+
+}  // namespace
+
 int orient_normals_precise(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
   {
     // Double-double needs round-to-nearest, whatever the caller set.
@@ -417,36 +455,14 @@ int orient_normals_precise(const NormalRef& a, const NormalRef& b, const NormalR
                                          : orient_near_pair(c, a, ub);
       if (s != kUndecided) return s;
     }
-    const PreciseNormal& p = a.polytope->precise_normal(a.face);
-    const PreciseNormal& q = b.polytope->precise_normal(b.face);
-    const PreciseNormal& r = c.polytope->precise_normal(c.face);
-    if (p.valid && q.valid && r.valid) {
-      // Three normals with the same zero component lie in one plane.
-      for (int i = 0; i < 3; ++i)
-        if (p.exactly_zero(i) && q.exactly_zero(i) && r.exactly_zero(i)) return 0;
-      auto dd = [](const PreciseNormal& n, int i) { return DD{n.hi[i], n.lo[i]}; };
-      auto minor = [&](int i, int j) { return dd(q, i) * dd(r, j) - dd(q, j) * dd(r, i); };
-      const DD value = dd(p, 0) * minor(1, 2) + dd(p, 1) * minor(2, 0) + dd(p, 2) * minor(0, 1);
-      // The evaluation: three levels of operations on terms bounded by the permanent.
-      double permanent = 0;
-      for (int i = 0; i < 3; ++i) {
-        const int j = (i + 1) % 3, l = (i + 2) % 3;
-        permanent +=
-            std::abs(p.hi[i]) * (std::abs(q.hi[j] * r.hi[l]) + std::abs(q.hi[l] * r.hi[j]));
-      }
-      // The inputs: det moves by at most |da| |b| |c| + |a'| |db| |c| + |a'| |b'| |dc|, with
-      // x' = x + dx.
-      const double la = length_bound(p), lb = length_bound(q), lc = length_bound(r);
-      const double da = error_bound(p), db = error_bound(q), dc = error_bound(r);
-      const double bound = (da * lb * lc + (la + da) * db * lc + (la + da) * (lb + db) * dc +
-                            64 * kU2 * permanent * 1.1) *
-                               1.01 +
-                           0x1p-1000;
-      if (value.hi > bound) return 1;
-      if (value.hi < -bound) return -1;
-    }
+    return orient_full_stage(a, b, c);
   }
   return kUndecided;
+}
+
+int orient_normals_precise_full(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
+  CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+  return orient_full_stage(a, b, c);
 }
 
 int cross_dot_normals_undecided(const NormalRef& a, const NormalRef& b, const NormalRef& c,

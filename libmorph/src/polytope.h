@@ -24,6 +24,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <thread>
 #include <vector>
 
 #include "exact.h"
@@ -221,6 +222,7 @@ struct Polytope {
   struct LazySlots {
     explicit LazySlots(int n) : slot(std::make_unique<std::atomic<const T*>[]>(n)), size(n) {}
     ~LazySlots() {
+      if (!filled.load(std::memory_order_relaxed)) return;  // usually: skip the scan
       for (int f = 0; f < size; ++f) delete slot[f].load(std::memory_order_relaxed);
     }
     template <class Compute>
@@ -229,15 +231,45 @@ struct Polytope {
       auto computed = std::make_unique<const T>(compute());
       const T* expected = nullptr;  // the first to publish wins
       if (slot[f].compare_exchange_strong(expected, computed.get(), std::memory_order_acq_rel,
-                                          std::memory_order_acquire))
+                                          std::memory_order_acquire)) {
+        filled.store(true, std::memory_order_relaxed);
         return *computed.release();
+      }
       return *expected;
     }
     std::unique_ptr<std::atomic<const T*>[]> slot;
     int size;
+    std::atomic<bool> filled{false};
+  };
+  // Precise normals are small and trivially copyable, and a sum of two fine spheres needs
+  // a hundred or so: one flat array instead of an allocation each. Each slot is written once,
+  // by the first reader to claim it; a reader that loses the race waits for that copy (the
+  // same values: the computation is deterministic).
+  template <class T>
+  struct FlatSlots {
+    explicit FlatSlots(int n)
+        : value(std::make_unique_for_overwrite<T[]>(n)),
+          state(std::make_unique<std::atomic<unsigned char>[]>(n)) {}
+    template <class Compute>
+    const T& get(int f, const Compute& compute) {
+      std::atomic<unsigned char>& s = state[f];
+      if (s.load(std::memory_order_acquire) == kReady) return value[f];
+      const T computed = compute();
+      unsigned char expected = kEmpty;
+      if (s.compare_exchange_strong(expected, kWriting, std::memory_order_acquire)) {
+        value[f] = computed;
+        s.store(kReady, std::memory_order_release);
+      } else {
+        while (s.load(std::memory_order_acquire) != kReady) std::this_thread::yield();
+      }
+      return value[f];
+    }
+    static constexpr unsigned char kEmpty = 0, kWriting = 1, kReady = 2;
+    std::unique_ptr<T[]> value;
+    std::unique_ptr<std::atomic<unsigned char>[]> state;  // value-initialised: kEmpty
   };
   mutable std::shared_ptr<LazySlots<V3<ExactN>>> exact_cache_;
-  mutable std::shared_ptr<LazySlots<PreciseNormal>> precise_cache_;
+  mutable std::shared_ptr<FlatSlots<PreciseNormal>> precise_cache_;
 };
 
 /// A facet normal as a predicate argument.
@@ -272,6 +304,9 @@ int cross_dot_normals_undecided(const NormalRef& a, const NormalRef& b, const No
 /// Each stage alone (for callers with shortcuts of their own between them, gauss_map.h):
 /// the double-double stage returns the sign or kUndecided; the exact stage, the sign.
 int orient_normals_precise(const NormalRef& a, const NormalRef& b, const NormalRef& c);
+/// orient_normals_precise without its nearly parallel pair's step, for callers that tried that
+/// step already (gauss_map.cpp's kept cross products): det on the three precise normals.
+int orient_normals_precise_full(const NormalRef& a, const NormalRef& b, const NormalRef& c);
 int orient_normals_exact(const NormalRef& a, const NormalRef& b, const NormalRef& c);
 int cross_dot_normals_precise(const NormalRef& a, const NormalRef& b, const NormalRef& c,
                               const NormalRef& d);
