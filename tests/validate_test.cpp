@@ -603,6 +603,23 @@ TEST_CASE("validate: quadrilaterals keep the general path's verdicts and message
     check_quad_variants(mesh_of(flat, kCubeQuads), "flat");
     check_quad_variants(mesh_of(cube_points(), reversed(kCubeQuads)), "inverted");
   }
+  SUBCASE("quads whose corners' x coordinates all differ, or not") {
+    // quad_corners_distinct() passes a quad with four different x coordinates at once and tests
+    // the others in full: the cube above takes the second way, a sheared cube (no two corners
+    // with one x) the first, and its pinched and dented variants either.
+    const auto sheared = [](std::vector<Point> points) {
+      for (auto& p : points) p[0] += 0.25 * p[1] + 0.625 * p[2];
+      return points;
+    };
+    CHECK(check_quad_variants(mesh_of(sheared(cube_points()), kCubeQuads), "sheared").empty());
+    std::vector<Point> pinched = cube_points();
+    pinched[7] = pinched[6];
+    CHECK(check_quad_variants(mesh_of(sheared(pinched), kCubeQuads), "sheared, pinched") ==
+          "face 1 has two vertices at the same position");
+    std::vector<Point> dented = cube_points();
+    dented[7] = Point(0.9, 0.9, 0.9);
+    check_quad_variants(mesh_of(sheared(dented), kCubeQuads), "sheared, dented");
+  }
 }
 
 // nondegenerate() plans two triangles, or two quadrilaterals, at once where they follow each

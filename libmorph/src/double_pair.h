@@ -81,4 +81,17 @@ inline bool both_true(PairMask mask) {
 #endif
 }
 
+/// Whether a == b, c == d or e == f in either lane (as the scalar ==: false for a NaN), in one
+/// branch.
+inline bool any_equal(Pair a, Pair b, Pair c, Pair d, Pair e, Pair f) {
+#if defined(__SSE2__)
+  const __m128d equal =
+      _mm_or_pd(_mm_or_pd(_mm_cmpeq_pd(a, b), _mm_cmpeq_pd(c, d)), _mm_cmpeq_pd(e, f));
+  return _mm_movemask_pd(equal) != 0;
+#else
+  return a[0] == b[0] || a[1] == b[1] || c[0] == d[0] || c[1] == d[1] || e[0] == f[0] ||
+         e[1] == f[1];
+#endif
+}
+
 }  // namespace morph::detail

@@ -708,8 +708,18 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, const S
 // quadrilateral repeats a vertex or a position, and quad_passes() returns false, having changed
 // nothing, then or when it has zero area: the general path then names the problem (a repeated
 // vertex does not zero a quadrilateral's normal, so both are tested here).
-bool quad_corners_distinct(const MeshView& m, const int* ids) {
+[[gnu::always_inline]] inline bool quad_corners_distinct(const MeshView& m, const int* ids) {
   const int i0 = ids[0], i1 = ids[1], i2 = ids[2], i3 = ids[3];
+  {
+    // The usual case first: four pairwise different x coordinates make four different positions
+    // (so four different vertices), told by three comparisons of pairs. Otherwise (two corners
+    // with the same x, as a quadrilateral of a grid aligned with an axis has) the tests below.
+    const double x0 = m.points[i0][0], x1 = m.points[i1][0], x2 = m.points[i2][0],
+                 x3 = m.points[i3][0];
+    if (!detail::any_equal(Pair{x0, x0}, Pair{x1, x2}, Pair{x0, x1}, Pair{x3, x2}, Pair{x1, x2},
+                           Pair{x3, x3}))
+      return true;
+  }
   if (i0 == i1 || i0 == i2 || i0 == i3 || i1 == i2 || i1 == i3 || i2 == i3) return false;
   const Point &p0 = m.points[i0], &p1 = m.points[i1], &p2 = m.points[i2], &p3 = m.points[i3];
   return !(p0 == p1 || p0 == p2 || p0 == p3 || p1 == p2 || p1 == p3 || p2 == p3);
