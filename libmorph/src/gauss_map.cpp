@@ -259,8 +259,8 @@ bool near_cross(const NormalRef& x, const NormalRef& y, double w[3], double& eps
 /// may be zero, which only the later stages show; trying this stage first there measured
 /// slower). `tried`: set when this stage ran (decided or not), so that the caller skips
 /// orient_normals_precise's repetition of it.
-int orient_near_cached(NearPairs& pairs, const NormalRef& a, const NormalRef& b,
-                       const NormalRef& c, bool& tried) {
+int orient_near_cached(NearPairs& pairs, const NormalRef& a, const NormalRef& b, const NormalRef& c,
+                       bool& tried) {
   const UnitNormal &ua = a.unit(), &ub = b.unit(), &uc = c.unit();
   auto may_be_zero = [](double pa, double pb, double pc, double ea, double eb, double ec) {
     return std::abs(pa) <= ea && std::abs(pb) <= eb && std::abs(pc) <= ec;

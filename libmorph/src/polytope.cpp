@@ -401,8 +401,7 @@ int orient_full_stage(const NormalRef& a, const NormalRef& b, const NormalRef& c
     double permanent = 0;
     for (int i = 0; i < 3; ++i) {
       const int j = (i + 1) % 3, l = (i + 2) % 3;
-      permanent +=
-          std::abs(p.hi[i]) * (std::abs(q.hi[j] * r.hi[l]) + std::abs(q.hi[l] * r.hi[j]));
+      permanent += std::abs(p.hi[i]) * (std::abs(q.hi[j] * r.hi[l]) + std::abs(q.hi[l] * r.hi[j]));
     }
     // The inputs: det moves by at most |da| |b| |c| + |a'| |db| |c| + |a'| |b'| |dc|, with
     // x' = x + dx.
@@ -421,43 +420,40 @@ int orient_full_stage(const NormalRef& a, const NormalRef& b, const NormalRef& c
 }  // namespace
 
 int orient_normals_precise(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
-  {
-    // Double-double needs round-to-nearest, whatever the caller set.
-    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
-    // A component within the unit normals' error bounds of zero in all three may be exactly
-    // zero in all three (mirror-symmetric facets): then det is zero, shown cheaply for
-    // triangles by component_surely_zero, else by the full stage.
-    const UnitNormal &ua = a.unit(), &ub = b.unit(), &uc = c.unit();
-    const double pa[3] = {ua.x, ua.y, ua.z}, pb[3] = {ub.x, ub.y, ub.z}, pc[3] = {uc.x, uc.y, uc.z};
-    bool may_share_zero = false;
-    for (int i = 0; i < 3; ++i) {
-      if (!(std::abs(pa[i]) <= ua.error && std::abs(pb[i]) <= ub.error &&
-            std::abs(pc[i]) <= uc.error))
-        continue;
-      may_share_zero = true;
-      if (component_surely_zero(*a.polytope, a.face, i) &&
-          component_surely_zero(*b.polytope, b.face, i) &&
-          component_surely_zero(*c.polytope, c.face, i))
-        return 0;
-    }
-    // Otherwise what the double stage leaves undecided is mostly a nearly parallel pair (two
-    // fine spheres) with a far third normal: first orient_near_pair, which needs only the
-    // pair's precise normals (det(a, b, c) = c . (a x b) = a . (b x c) = b . (c x a), the pair
-    // the one whose unit normals' dot product is largest in magnitude). It cannot show a zero,
-    // so triples that may share a zero component go straight to the full stage.
-    if (!may_share_zero) {
-      auto dot = [](const UnitNormal& u, const UnitNormal& v) {
-        return std::abs(u.x * v.x + u.y * v.y + u.z * v.z);
-      };
-      const double ab = dot(ua, ub), bc = dot(ub, uc), ca = dot(uc, ua);
-      const int s = ab >= bc && ab >= ca ? orient_near_pair(a, b, uc)
-                    : bc >= ca           ? orient_near_pair(b, c, ua)
-                                         : orient_near_pair(c, a, ub);
-      if (s != kUndecided) return s;
-    }
-    return orient_full_stage(a, b, c);
+  // Double-double needs round-to-nearest, whatever the caller set.
+  CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+  // A component within the unit normals' error bounds of zero in all three may be exactly
+  // zero in all three (mirror-symmetric facets): then det is zero, shown cheaply for
+  // triangles by component_surely_zero, else by the full stage.
+  const UnitNormal &ua = a.unit(), &ub = b.unit(), &uc = c.unit();
+  const double pa[3] = {ua.x, ua.y, ua.z}, pb[3] = {ub.x, ub.y, ub.z}, pc[3] = {uc.x, uc.y, uc.z};
+  bool may_share_zero = false;
+  for (int i = 0; i < 3; ++i) {
+    if (!(std::abs(pa[i]) <= ua.error && std::abs(pb[i]) <= ub.error &&
+          std::abs(pc[i]) <= uc.error))
+      continue;
+    may_share_zero = true;
+    if (component_surely_zero(*a.polytope, a.face, i) &&
+        component_surely_zero(*b.polytope, b.face, i) &&
+        component_surely_zero(*c.polytope, c.face, i))
+      return 0;
   }
-  return kUndecided;
+  // Otherwise what the double stage leaves undecided is mostly a nearly parallel pair (two
+  // fine spheres) with a far third normal: first orient_near_pair, which needs only the
+  // pair's precise normals (det(a, b, c) = c . (a x b) = a . (b x c) = b . (c x a), the pair
+  // the one whose unit normals' dot product is largest in magnitude). It cannot show a zero,
+  // so triples that may share a zero component go straight to the full stage.
+  if (!may_share_zero) {
+    auto dot = [](const UnitNormal& u, const UnitNormal& v) {
+      return std::abs(u.x * v.x + u.y * v.y + u.z * v.z);
+    };
+    const double ab = dot(ua, ub), bc = dot(ub, uc), ca = dot(uc, ua);
+    const int s = ab >= bc && ab >= ca ? orient_near_pair(a, b, uc)
+                  : bc >= ca           ? orient_near_pair(b, c, ua)
+                                       : orient_near_pair(c, a, ub);
+    if (s != kUndecided) return s;
+  }
+  return orient_full_stage(a, b, c);
 }
 
 int orient_normals_precise_full(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
