@@ -81,6 +81,36 @@ std::vector<V3<double>> cube_points() {
   return points;
 }
 
+/// Facets as clean_mesh takes them: their corners one after another, facet f's from
+/// begin[f] to begin[f + 1].
+struct FlatFacets {
+  std::vector<int> begin{0}, corners;
+};
+FlatFacets flatten(const std::vector<std::vector<int>>& facets) {
+  FlatFacets flat;
+  for (const auto& f : facets) {
+    flat.corners.insert(flat.corners.end(), f.begin(), f.end());
+    flat.begin.push_back(static_cast<int>(flat.corners.size()));
+  }
+  return flat;
+}
+
+/// clean_mesh of the facets, with each result facet's source and the number of times it
+/// fell back to the hull.
+struct Cleaned {
+  morph::Mesh mesh;
+  std::vector<int> source;
+  long hulls = 0;
+};
+Cleaned clean_facets(const std::vector<V3<double>>& points,
+                     const std::vector<std::vector<int>>& facets) {
+  const auto [begin, corners] = flatten(facets);
+  Cleaned cleaned;
+  const long before = morph::detail::clean_mesh_hull_fallbacks();
+  cleaned.mesh = clean_mesh(points, begin, corners, &cleaned.source);
+  cleaned.hulls = morph::detail::clean_mesh_hull_fallbacks() - before;
+  return cleaned;
+}
 // The merged soup's twins are checked only where a group merged or a vertex went; the
 // facets left alone keep theirs. Any subset of the faces split: the cube each time.
 // The unit cube (vertex x + 2y + 4z) with its top split in two along x = 1/2: the
@@ -100,11 +130,7 @@ TEST_CASE("clean_mesh merges a split facet and drops the vertices in the middle 
       {0, 4, 6, 2},     // left
       {1, 3, 7, 5},     // right
   };
-  std::vector<int> begin{0}, corners;
-  for (const auto& f : facets) {
-    corners.insert(corners.end(), f.begin(), f.end());
-    begin.push_back(static_cast<int>(corners.size()));
-  }
+  auto [begin, corners] = flatten(facets);
   std::vector<int> source;
   const morph::Mesh mesh = clean_mesh(points, begin, corners, &source);
   check_cube(mesh);
@@ -209,11 +235,7 @@ TEST_CASE("clean_mesh drops a needle folded by its short diagonal without the hu
         {1, 3, 7, 5},     // right
         needle,
     };
-    std::vector<int> begin{0}, corners;
-    for (const auto& f : facets) {
-      corners.insert(corners.end(), f.begin(), f.end());
-      begin.push_back(static_cast<int>(corners.size()));
-    }
+    auto [begin, corners] = flatten(facets);
     CAPTURE(needle);
     std::vector<int> source;
     const long before = morph::detail::clean_mesh_hull_fallbacks();
@@ -261,24 +283,17 @@ TEST_CASE("clean_mesh finds a close pair at each place in a triangle, at any sca
               {0, 2, 3, 1}, {8, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3},
               {0, 4, 6, 2}, {1, 3, 7, 5}, sliver,
           };
-          std::vector<int> begin{0}, corners;
-          for (const auto& f : facets) {
-            corners.insert(corners.end(), f.begin(), f.end());
-            begin.push_back(static_cast<int>(corners.size()));
-          }
-          std::vector<int> source;
-          const long before = morph::detail::clean_mesh_hull_fallbacks();
-          const morph::Mesh mesh = clean_mesh(points, begin, corners, &source);
+          const auto [mesh, source, hulls] = clean_facets(points, facets);
           if (offset < 1e-9) {
             // 8 merges into 4: the cube as given, the sliver gone, no hull.
-            CHECK(morph::detail::clean_mesh_hull_fallbacks() == before);
+            CHECK(hulls == 0);
             CHECK(mesh.n_vertices() == 8);
             CHECK(mesh.n_faces() == 6);
             for (auto f : mesh.faces()) CHECK(mesh.valence(f) == 4);
             CHECK(std::find(source.begin(), source.end(), 6) == source.end());
           } else {
             // Nothing merges, and the edge 8 -> 5 is used twice: only the hull mends it.
-            CHECK(morph::detail::clean_mesh_hull_fallbacks() == before + 1);
+            CHECK(hulls == 1);
           }
         }
       }
@@ -315,22 +330,15 @@ TEST_CASE("clean_mesh finds a close pair in either facet of two taken together")
           }
           std::rotate(sliver.begin(), sliver.begin() + turn, sliver.end());
           facets.insert(facets.begin() + at, sliver);
-          std::vector<int> begin{0}, corners;
-          for (const auto& f : facets) {
-            corners.insert(corners.end(), f.begin(), f.end());
-            begin.push_back(static_cast<int>(corners.size()));
-          }
-          std::vector<int> source;
-          const long before = morph::detail::clean_mesh_hull_fallbacks();
-          const morph::Mesh mesh = clean_mesh(points, begin, corners, &source);
+          const auto [mesh, source, hulls] = clean_facets(points, facets);
           if (offset < 1e-9) {
             // 8 merges into 4 and 9 into 5: the cube, the sliver gone, no hull.
-            CHECK(morph::detail::clean_mesh_hull_fallbacks() == before);
+            CHECK(hulls == 0);
             check_cube(mesh);
             CHECK(std::find(source.begin(), source.end(), at) == source.end());
           } else {
             // Nothing merges, and an edge is used twice: only the hull mends it.
-            CHECK(morph::detail::clean_mesh_hull_fallbacks() == before + 1);
+            CHECK(hulls == 1);
           }
         }
 }
@@ -347,15 +355,8 @@ TEST_CASE("clean_mesh drops facets of fewer than three corners at any place") {
       std::vector<std::vector<int>> facets = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
                                               {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
       facets.insert(facets.begin() + at, stub);
-      std::vector<int> begin{0}, corners;
-      for (const auto& f : facets) {
-        corners.insert(corners.end(), f.begin(), f.end());
-        begin.push_back(static_cast<int>(corners.size()));
-      }
-      std::vector<int> source;
-      const long before = morph::detail::clean_mesh_hull_fallbacks();
-      const morph::Mesh mesh = clean_mesh(cube_points(), begin, corners, &source);
-      CHECK(morph::detail::clean_mesh_hull_fallbacks() == before);
+      const auto [mesh, source, hulls] = clean_facets(cube_points(), facets);
+      CHECK(hulls == 0);
       check_cube(mesh);
       CHECK(std::find(source.begin(), source.end(), at) == source.end());
     }
@@ -786,11 +787,7 @@ TEST_CASE("clean_mesh finds the planes of consecutive facets two at a time") {
       for (const std::vector<int>& f : std::vector<std::vector<int>>{
                {0, 1, 5, 8, 4}, {2, 6, 9, 7, 3}, {0, 2, 3, 1}, {0, 4, 6, 2}, {1, 3, 7, 5}})
         facets.push_back(f);
-      std::vector<int> begin{0}, corners;
-      for (const auto& f : facets) {
-        corners.insert(corners.end(), f.begin(), f.end());
-        begin.push_back(static_cast<int>(corners.size()));
-      }
+      auto [begin, corners] = flatten(facets);
       const morph::Mesh mesh = clean_mesh(points, begin, corners, nullptr);
       if (h == 0) {
         check_cube(mesh);
