@@ -24,10 +24,10 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
-#include <thread>
 #include <vector>
 
 #include "exact.h"
+#include "run_once.h"
 
 namespace morph::detail {
 
@@ -242,9 +242,8 @@ struct Polytope {
     std::atomic<bool> filled{false};
   };
   // Precise normals are small and trivially copyable, and a sum of two fine spheres needs
-  // a hundred or so: one flat array instead of an allocation each. Each slot is written once,
-  // by the first reader to claim it; a reader that loses the race waits for that copy (the
-  // same values: the computation is deterministic).
+  // a hundred or so: one flat array instead of an allocation each. Each slot is made once,
+  // by the first reader to claim it (run_once); a reader that comes meanwhile waits for it.
   template <class T>
   struct FlatSlots {
     explicit FlatSlots(int n)
@@ -253,20 +252,12 @@ struct Polytope {
     template <class Compute>
     const T& get(int f, const Compute& compute) {
       std::atomic<unsigned char>& s = state[f];
-      if (s.load(std::memory_order_acquire) == kReady) return value[f];
-      const T computed = compute();
-      unsigned char expected = kEmpty;
-      if (s.compare_exchange_strong(expected, kWriting, std::memory_order_acquire)) {
-        value[f] = computed;
-        s.store(kReady, std::memory_order_release);
-      } else {
-        while (s.load(std::memory_order_acquire) != kReady) std::this_thread::yield();
-      }
+      if (s.load(std::memory_order_acquire) != once_state::kDone)
+        run_once(s, [&] { value[f] = compute(); });
       return value[f];
     }
-    static constexpr unsigned char kEmpty = 0, kWriting = 1, kReady = 2;
     std::unique_ptr<T[]> value;
-    std::unique_ptr<std::atomic<unsigned char>[]> state;  // value-initialised: kEmpty
+    std::unique_ptr<std::atomic<unsigned char>[]> state;  // value-initialised: kNone
   };
   mutable std::shared_ptr<LazySlots<V3<ExactN>>> exact_cache_;
   mutable std::shared_ptr<FlatSlots<PreciseNormal>> precise_cache_;
