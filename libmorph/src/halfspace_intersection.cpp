@@ -256,10 +256,15 @@ struct ExactCoordinates {
 /// of three of the planes. The exact coordinates are computed only where the filters
 /// (intervals, then double-double) cannot decide, or for a polytope chained further.
 struct HVertex {
-  std::array<int, 3> planes;
+  // User-provided: a value-initialised HVertex (a surface's `vertex`, resized by the
+  // thousand) is then built by its member initialisers alone, not first zeroed whole
+  // (rep stos per vertex: up to 1.6% of an erosion).
+  HVertex() {}
+  std::array<int, 3> planes{};
   int known = -1;  // the known point it is (KnownPoints), if any
-  V3<Interval> Xi;
-  Interval Wi;  // (X / W as Xi / Wi where needed: quotient, not kept)
+  // Read only where `intervals` or `fast` is set.
+  V3<Interval> Xi{Interval(0), Interval(0), Interval(0)};
+  Interval Wi{0};  // (X / W as Xi / Wi where needed: quotient, not kept)
   // The exact coordinates, once known (X not null): a known point's are KnownPoints' own
   // (not copied: most are never read), another's are made on first need into `made`. Off
   // the vertex itself (four Mpzf are 350 bytes), which the flips and the check create,
@@ -1489,19 +1494,48 @@ bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& preci
   return kept >= 4;
 }
 
+/// The check's ray from o: r, with u = e_k x r and w = r x u exactly orthogonal to it, and
+/// per plane the signs of its normal against them (`away`, see build_verified). Kept from a
+/// check for the check after its repair: the planes are the same, and any ray from o serves
+/// the test (it counts the triangles the ray crosses, whichever it is).
+struct CheckRay {
+  V3<ExactN> r, u, w;
+  std::vector<unsigned char> away;
+};
+
+constexpr double kAwayRange = 0x1p400;
+
+/// Sign of <g, n> for plane p, g enclosed by gi (any rounding mode; 2 where undecided): the
+/// double filter's when p is fast, from g's lower ends gc (within the widths d of g) and
+/// p's doubles (each within 2 v of itself, plus a subnormal's gap: kDoubleFloor). The
+/// evaluation (three products, two sums: gamma_5) and the normal's error take kMeetError of
+/// the magnitude; <d, |n|> (rounded upward) twice covers the move by g's widths. Needs
+/// |g| <= kAwayRange (no overflow: |<g, n>| < 2^462).
+int away_sign(const Plane& p, const V3<double>& gc, const V3<double>& d) {
+  if (!p.fast) return 2;
+  const V3<double> na = p.na();
+  const double value = dot(gc, p.nd);
+  const double magnitude = std::abs(gc.x) * na.x + std::abs(gc.y) * na.y + std::abs(gc.z) * na.z;
+  const double bound = kMeetError * magnitude + 2 * dot(d, na) + kDoubleFloor;
+  if (value > bound) return 1;
+  if (value < -bound) return -1;
+  return 2;
+}
+
 /// Builds the intersection from a candidate dual hull, checking exactly that it is the
 /// dual hull of all the planes; nullopt when it is not. The result has `rounded`, and
 /// `polytope` when options.polytope (its exact points computed up front when
 /// options.eager_exact, else on demand: polytope_points).
 /// `repaired`, when not null (a guess, with its triangles' vertices), allows edges that are
 /// not locally convex to be repaired (repair_surface) and the result checked again; it
-/// tells whether that happened.
+/// tells whether that happened. `given_ray`: the ray of the check before a repair.
 std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
                                             const std::vector<Plane>& planes,
                                             const PrecisePlanes& precise, const KnownPoints& known,
                                             DualSurface s, const IntersectOptions& options,
                                             const std::shared_ptr<const void>& owner,
-                                            bool* repaired = nullptr) {
+                                            bool* repaired = nullptr,
+                                            const CheckRay* given_ray = nullptr) {
   const bool with_polytope = options.polytope;
   const int nt = static_cast<int>(s.corner.size());
   const int n = static_cast<int>(planes.size());
@@ -1525,17 +1559,22 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   });
   if (!ok) return std::nullopt;
   // A ray from o crosses exactly one triangle: through the inside of triangle 0, and
-  // strictly inside or outside every other one.
-  {
+  // strictly inside or outside every other one. (After a repair: the ray before it, through
+  // the inside of the triangle that was triangle 0 then; the count is the test.)
+  CheckRay made_ray;
+  const CheckRay& check_ray = given_ray ? *given_ray : made_ray;
+  if (!given_ray) {
     const auto& c0 = s.corner[0];
-    const V3<ExactN> r = planes[c0[0]].n() + planes[c0[1]].n() + planes[c0[2]].n();
+    V3<ExactN>& r = made_ray.r;
+    r = planes[c0[0]].n() + planes[c0[1]].n() + planes[c0[2]].n();
     // A triangle whose three normals lie strictly on one side of a plane through o that
     // holds r or leaves it on the other side (<g, n> > 0 for all three, <g, r> <= 0) is
     // missed without its determinants: its cone holds no such r, so one of them would be
     // negative. Tested by intervals for g = -r (normals pointing away from the ray) and
     // for two planes through the ray, g = +-u and +-w with u = e_k x r, w = r x u exactly
     // orthogonal to r (Mpzf): only the few triangles around the ray are left to test.
-    V3<ExactN> u{ExactN(0), ExactN(0), ExactN(0)};
+    V3<ExactN>& u = made_ray.u;
+    u = {ExactN(0), ExactN(0), ExactN(0)};
     {
       // e_k the axis of r's smallest component, so that u is far from zero.
       const double ax = std::abs(r.x.to_double()), ay = std::abs(r.y.to_double()),
@@ -1547,20 +1586,42 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       else
         u = {ExactN(0) - r.y, r.x, ExactN(0)};  // e_z x r
     }
-    const V3<ExactN> w = cross(r, u);
+    made_ray.w = cross(r, u);
     // Per plane, bit 0: <r, n> < 0; bits 1, 2: <u, n> > 0, < 0; bits 3, 4: <w, n> > 0, < 0.
-    std::vector<unsigned char> away(n);
+    // Only a filter (a bit not set where the sign is undecided: more triangles tested).
+    std::vector<unsigned char>& away = made_ray.away;
+    away.resize(n);
     parallel_chunks(n, 1024, [&](int begin, int end) {
       RoundingGuard guard;
-      const V3<Interval> ri = to_interval_n(r), ui = to_interval_n(u), wi = to_interval_n(w);
+      const V3<Interval> gi[3] = {to_interval_n(r), to_interval_n(u), to_interval_n(made_ray.w)};
+      // The double filter's copies of r, u, w (their lower ends and widths, rounded up),
+      // where all are within kAwayRange.
+      V3<double> gc[3], gd[3];
+      bool doubles = true;
+      for (int g = 0; g < 3; ++g) {
+        gc[g] = {gi[g].x.inf(), gi[g].y.inf(), gi[g].z.inf()};
+        gd[g] = {gi[g].x.sup() - gi[g].x.inf(), gi[g].y.sup() - gi[g].y.inf(),
+                 gi[g].z.sup() - gi[g].z.inf()};
+        for (double x : {gi[g].x.inf(), gi[g].x.sup(), gi[g].y.inf(), gi[g].y.sup(), gi[g].z.inf(),
+                         gi[g].z.sup()})
+          doubles = doubles && std::abs(x) <= kAwayRange;  // (false for NaN)
+      }
+      const auto sign_of = [&](const Plane& p, int g) {
+        const int s = doubles ? away_sign(p, gc[g], gd[g]) : 2;
+        return s != 2 ? s : interval_sign(dot(gi[g], p.ni));
+      };
       const auto bits = [](int sign, int positive, int negative) {
         return sign == 1 ? positive : sign == -1 ? negative : 0;
       };
       for (int p = begin; p < end; ++p)
-        away[p] = static_cast<unsigned char>(bits(interval_sign(dot(ri, planes[p].ni)), 0, 1) |
-                                             bits(interval_sign(dot(ui, planes[p].ni)), 2, 4) |
-                                             bits(interval_sign(dot(wi, planes[p].ni)), 8, 16));
+        away[p] = static_cast<unsigned char>(bits(sign_of(planes[p], 0), 0, 1) |
+                                             bits(sign_of(planes[p], 1), 2, 4) |
+                                             bits(sign_of(planes[p], 2), 8, 16));
     });
+  }
+  {
+    const V3<ExactN>& r = check_ray.r;
+    const std::vector<unsigned char>& away = check_ray.away;
     std::atomic<int> hits = 0;
     parallel_chunks(nt, 512, [&](int begin, int end) {
       RoundingGuard guard;
@@ -1686,7 +1747,8 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     s.far_side = std::move(far_side);
     if (!repair_surface(planes, precise, known, s, edges)) return std::nullopt;
     *repaired = true;
-    return build_verified(hs, planes, precise, known, std::move(s), options, owner);
+    return build_verified(hs, planes, precise, known, std::move(s), options, owner, nullptr,
+                          &check_ray);
   }
   std::vector<int> group(nt, -1), seed;
   {
