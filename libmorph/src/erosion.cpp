@@ -233,7 +233,7 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
         fixed::Int<3> offset;
         if (h.has_normal_dd &&
             n.small_words(0, top, pb, normal, w.normal_exp, offset, w.offset_exp)) {
-          CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+          RoundingGuard nearest(CGAL_FE_TONEAREST);
           if (fixed::to_dd(offset, w.offset_exp, h.offset_dd)) {
             w.n = {normal.x, normal.y, normal.z};
             w.d = {offset.w[0], offset.w[1], offset.w[2]};

@@ -665,7 +665,7 @@ class PrecisePlanes {
   explicit PrecisePlanes(const std::vector<Plane>& planes)
       : planes_(planes), precise_(planes.size()), once_(planes.size()) {
     parallel_chunks(static_cast<int>(planes.size()), 512, [&](int begin, int end) {
-      CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+      RoundingGuard nearest(CGAL_FE_TONEAREST);
       for (int i = begin; i < end; ++i) {
         const HalfSpace* h = planes[i].source;
         if (!h || !h->has_normal_dd || !h->has_offset_dd) continue;
@@ -676,7 +676,7 @@ class PrecisePlanes {
   }
   const PrecisePlane& operator[](int i) const {  // any rounding mode
     once_.call(i, [&] {
-      CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+      RoundingGuard nearest(CGAL_FE_TONEAREST);
       precise_[i] = precise_plane(planes_[i]);
     });
     return precise_[i];
@@ -831,7 +831,7 @@ int side_filter(const std::vector<Plane>& planes, const PrecisePlanes& precise, 
   // the plane's precise copy is made already; after them otherwise (its conversion costs more).
   const bool stage = v.precise && v.known < 0;
   const auto precise_sign = [&] {
-    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    RoundingGuard nearest(CGAL_FE_TONEAREST);
     const PrecisePlane& q = precise[i];
     return q.valid ? precise_side(q, v) : 2;
   };
@@ -860,7 +860,7 @@ int side(const std::vector<Plane>& planes, const PrecisePlanes& precise, int i, 
   // most of those the intervals cannot decide either, and the precise coordinates are
   // needed for the rounding anyway.
   if (v.known < 0) {
-    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    RoundingGuard nearest(CGAL_FE_TONEAREST);
     if (!v.precise_tried) make_precise(precise, v);
     const PrecisePlane& q = precise[i];
     if (v.precise && q.valid) {
@@ -885,7 +885,7 @@ int compare_filter(const std::vector<Plane>& planes, const PrecisePlanes& precis
   // As in side_filter: the precise stage first when the plane's copy is made.
   const bool stage = u.precise && v.precise && (u.known < 0 || v.known < 0);
   const auto precise_sign = [&] {
-    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    RoundingGuard nearest(CGAL_FE_TONEAREST);
     const PrecisePlane& q = precise[i];
     return q.valid ? precise_compare(q, u, v) : 2;
   };
@@ -1030,7 +1030,7 @@ int det_sign(const std::vector<Plane>& planes, const PrecisePlanes& precise, int
   const int s = interval_sign(det(pa.ni, pb.ni, pc.ni));
   if (s != 2) return s;
   {
-    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    RoundingGuard nearest(CGAL_FE_TONEAREST);
     const PrecisePlane &x = precise[a], &y = precise[b], &z = precise[c];
     const int t = x.valid && y.valid && z.valid ? precise_det_sign(x, y, z) : 2;
     if (t != 2) return t;
@@ -1878,7 +1878,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     return from_planes[u] && u < t;
   };
   parallel_chunks(nv, 128, [&](int begin, int end) {
-    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    RoundingGuard nearest(CGAL_FE_TONEAREST);
     for (int v = begin; v < end; ++v) {
       const int t = seed[v];
       if (!from_planes[t]) continue;
@@ -1889,7 +1889,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     }
   });
   parallel_chunks(nv, 128, [&](int begin, int end) {
-    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    RoundingGuard nearest(CGAL_FE_TONEAREST);
     for (int v = begin; v < end; ++v) {
       const int t = seed[v];
       if (!from_planes[t]) {
@@ -2085,7 +2085,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   RoundedPolytope& rp = out.rounded;
   rp.points.resize(nv);
   parallel_chunks(nv, 128, [&](int begin, int end) {
-    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);  // for round_precise
+    RoundingGuard nearest(CGAL_FE_TONEAREST);  // for round_precise
     const auto coordinate = [](const auto& p, int i) -> const auto& {
       return i == 0 ? p.x : i == 1 ? p.y : p.z;
     };
@@ -2295,7 +2295,7 @@ class IncrementalHull {
     // The precise stage, for real planes (nearly through one point: the moved facets around
     // a vertex of a nearly planar A).
     if (p < n_ && tri.precise != -2 && std::max({tri.c[0], tri.c[1], tri.c[2]}) < n_) {
-      CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+      RoundingGuard nearest(CGAL_FE_TONEAREST);
       if (tri.precise < 0) {
         HVertex v;
         v.planes = tri.c;
@@ -2519,7 +2519,7 @@ void probe_rounding(const HVertex& v, PreciseProbe& out) {
 
 PreciseProbe probe_precise(const std::vector<HalfSpace>& hs) {
   const std::vector<Plane> planes = planes_of(hs);
-  CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+  RoundingGuard nearest(CGAL_FE_TONEAREST);
   const PrecisePlanes precise(planes);
   PreciseProbe out;
   HVertex u;
@@ -2552,7 +2552,7 @@ DoubleProbe probe_double(const std::vector<HalfSpace>& hs) {
 }
 
 PreciseProbe probe_precise_point(const V3<ExactN>& X, const ExactN& W) {
-  CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+  RoundingGuard nearest(CGAL_FE_TONEAREST);
   PreciseProbe out;
   HVertex v;
   v.known = 0;
@@ -2565,7 +2565,7 @@ PreciseProbe probe_precise_point(const V3<ExactN>& X, const ExactN& W) {
 }
 
 void set_normal_dd(HalfSpace& h, const V3<double>& p0, const V3<double>& p1, const V3<double>& p2) {
-  CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+  RoundingGuard nearest(CGAL_FE_TONEAREST);
   // The edge vectors, each difference exact (two_sum's error term zero, no overflow).
   V3<double> e1, e2;
   const auto difference = [](double a, double b, double& out) {

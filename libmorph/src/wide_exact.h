@@ -391,7 +391,7 @@ class Normal {
     const std::uint64_t bits = static_cast<std::uint64_t>(1023 + e) << 52;
     double scale;
     std::memcpy(&scale, &bits, sizeof scale);
-    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    RoundingGuard nearest(CGAL_FE_TONEAREST);
     const i128 c[3] = {small_.x, small_.y, small_.z};
     for (int k = 0; k < 3; ++k) {
       // |c| below 2^126: magnitude_dd's hi and lo within 2^-105 |c| <= 2^-104 |hi|, integers,
@@ -423,7 +423,7 @@ class Normal {
     const auto set = [&](const auto& value) {
       set_exact(value, exp, out);
       if (!dd) return false;
-      CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+      RoundingGuard nearest(CGAL_FE_TONEAREST);
       return to_dd(value, exp, *dd);
     };
     if (frame_.small) {
