@@ -1038,3 +1038,34 @@ TEST_CASE("polytope: make_operands gives the same operands and errors with one t
     }
   }
 }
+
+// make_operand's check takes the bounding box from copy_points, which scans the even and the odd
+// vertices apart and computes the box again in index order when the two halves' extremes are
+// zeros of opposite signs (equal, but not the same bits). Cubes with -0.0 and +0.0 coordinates at
+// the vertices that decide each half's minimum (vertices 0 and 1), in either order, and a cube
+// whose maxima are zeros: the verdicts, polytopes and unit normals must be the check's and
+// compute_normals' whichever path they take.
+TEST_CASE("polytope: make_operand's check on cubes whose box corners are signed zeros") {
+  for (const double first : {-0.0, 0.0}) {
+    std::vector<Point> points = unit_cube_points();
+    const double second = -first;
+    for (int i = 0; i < 8; ++i)
+      for (int k = 0; k < 3; ++k)
+        if (points[i][k] == 0) points[i][k] = i % 2 == 0 ? first : second;
+    const std::string what = std::signbit(first) ? "-0 first" : "+0 first";
+    for (const auto& faces : {kQuads, split_quads()}) {
+      const Mesh mesh = morph::test::mesh_from_polygons(points, faces);
+      check_operand_agrees(mesh, what);
+      check_operand_normals(mesh, what);
+      // Reflected through the origin (the maxima are the zeros), with the facets reversed to
+      // stay outward.
+      std::vector<Point> reflected = points;
+      for (Point& q : reflected) q = Point(-q[0], -q[1], -q[2]);
+      std::vector<std::vector<int>> reversed = faces;
+      for (auto& f : reversed) std::reverse(f.begin(), f.end());
+      const Mesh mirror = morph::test::mesh_from_polygons(reflected, reversed);
+      check_operand_agrees(mirror, what + " reflected");
+      check_operand_normals(mirror, what + " reflected");
+    }
+  }
+}

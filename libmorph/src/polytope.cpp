@@ -946,7 +946,7 @@ bool operand_topology(const Polytope& p, const HalfedgeArrays& arrays, int nf, b
 /// face cycles, see FaceCycleView), and whether the mesh passes check_operand's topological
 /// checks.
 struct OperandTopology {
-  std::vector<int> across;
+  std::unique_ptr<int[]> across;  // one per corner, all written by a walk that passes
   bool passes = false;
 };
 
@@ -956,12 +956,14 @@ struct OperandTopology {
 /// face circulator's first vertex, edges in order of first use. Returns the mesh edge of
 /// each polytope edge. With `topology` (as given only), also tells whether check_operand's
 /// topological checks pass, from what the walks read anyway (see checked_polytope).
-std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, FaceOrder order,
-                                             OperandTopology* topology = nullptr) {
+/// In three instances (as given with and without `topology`, reversed without), so that each
+/// walk's loop tests neither the order nor `topology` and keeps more of its values in registers.
+template <bool reversed, bool checked>
+std::vector<int> connectivity_walks(Polytope& p, const Mesh& mesh, OperandTopology* topology) {
+  static_assert(!(reversed && checked), "the checked path reads the faces as given");
   const int nv = static_cast<int>(mesh.n_vertices());
   const int nf = static_cast<int>(mesh.n_faces());
   const int nh = static_cast<int>(mesh.n_halfedges());
-  const bool reversed = order == FaceOrder::reversed;
   // Corner c is a halfedge of its face: leaving the corner's vertex when as given; when
   // reversed, entering it (the facet runs against the halfedges). What the walks know of
   // mesh edge h / 2 (OpenMesh stores the two halfedges of edge e as 2e and 2e + 1), in its
@@ -974,6 +976,7 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   // Each edge has two corners once every halfedge is one face's: at most nh / 2 edges,
   // written by index in order of first use (at the smaller corner).
   std::vector<int> mesh_edge(nh / 2);
+  int* const mesh_edge_of = mesh_edge.data();
   p.edges.resize(nh / 2);
   int* const corner_vertex = p.corner_vertex.data();
   int* const corner_edge = p.corner_edge.data();
@@ -986,10 +989,10 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   // (the check reads it), and `across`.
   bool consistent = true;
   int* across = nullptr;
-  if (topology) {
+  if constexpr (checked) {
     topology->passes = false;
-    topology->across.resize(nh);
-    across = topology->across.data();
+    topology->across = std::make_unique_for_overwrite<int[]>(nh);
+    across = topology->across.get();
   }
   // One walk around each face: its corners, and each edge as its first corner meets it
   // (the edge's from, left facet and mesh edge) and completed at its second (to, right
@@ -1025,7 +1028,7 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
         state = (static_cast<unsigned>(edge) << 2) | bit;
         edges[edge].from = vertex;
         edges[edge].left = f;
-        mesh_edge[edge] = h >> 1;
+        mesh_edge_of[edge] = h >> 1;
       } else {
         edge = static_cast<int>(state >> 2);
         state |= bit;
@@ -1033,7 +1036,7 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
         edges[edge].right = f;
       }
       corner_edge[c] = edge;
-      if (topology) {
+      if constexpr (checked) {
         across[c] = arrays.face(previous ^ 1);
         consistent &= arrays.to(h ^ 1) == from;
       }
@@ -1058,7 +1061,7 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   int slot = 0;
   // The checked path: the vertex whose fan last reached each vertex (a neighbour reached
   // twice means two edges between the same vertices).
-  std::vector<int> seen(topology ? nv : 0, -1);
+  std::vector<int> seen(checked ? nv : 0, -1);
   // The checked path: whether every vertex but vertex 0 has a smaller neighbour (see
   // operand_topology).
   bool descending = true;
@@ -1082,7 +1085,7 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
       fan_edge[slot] = static_cast<int>(edge_state[g >> 1] >> 2);
       const int w = reversed ? arrays.to(g) : arrays.to(g ^ 1);
       fan_vertex[slot] = w;
-      if (topology) {
+      if constexpr (checked) {
         consistent &= seen[w] != v;
         seen[w] = v;
         smallest = std::min(smallest, w);
@@ -1094,8 +1097,15 @@ std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, Face
   }
   p.fan_begin[nv] = slot;
   if (slot != nc) throw error("internal error: a mesh vertex has several fans");
-  if (topology && consistent) topology->passes = operand_topology(p, arrays, nf, descending);
+  if (checked && consistent) topology->passes = operand_topology(p, arrays, nf, descending);
   return mesh_edge;
+}
+
+std::vector<int> connectivity_from_halfedges(Polytope& p, const Mesh& mesh, FaceOrder order,
+                                             OperandTopology* topology = nullptr) {
+  if (order == FaceOrder::reversed) return connectivity_walks<true, false>(p, mesh, nullptr);
+  if (topology) return connectivity_walks<false, true>(p, mesh, topology);
+  return connectivity_walks<false, false>(p, mesh, nullptr);
 }
 
 // Whether any of these status flags marks its element deleted: the flags or-ed together, a loop
@@ -1360,21 +1370,61 @@ constexpr int kParallelOperandFaces = 1000;
 /// in one pass; with `box`, also the points' bounding box as the operand check computes it (see
 /// geometry_passes).
 bool copy_points(Polytope& p, const Mesh& mesh, PointBox* box = nullptr) {
-  p.points.resize(mesh.n_vertices());
+  const int n = static_cast<int>(mesh.n_vertices());
+  p.points.resize(n);
   const Point* q = mesh.points();
+  V3<double>* const points = p.points.data();
   bool finite = true;
+  if (!box) {
+    for (int v = 0; v < n; ++v) {
+      const V3<double> x{q[v][0], q[v][1], q[v][2]};
+      finite &= std::isfinite(x.x) & std::isfinite(x.y) & std::isfinite(x.z);
+      points[v] = x;
+    }
+    return finite;
+  }
+  // The box in two halves, even and odd vertices, so that each minimum and maximum is two
+  // chains of half the length. Point's minimize() is std::min(lo, q) (maximize() std::max(hi,
+  // q)): in index order it keeps the first vertex among those equal to the extreme, so the
+  // halves' results combine to the same, except where they are equal as numbers but not as
+  // bits (+0 and -0): then the box is computed again in index order.
   constexpr double inf = std::numeric_limits<double>::infinity();
-  Point lo(inf, inf, inf), hi(-inf, -inf, -inf);
-  for (int v = 0; v < p.num_vertices(); ++v) {
-    const V3<double> x{q[v][0], q[v][1], q[v][2]};
-    finite &= std::isfinite(x.x) & std::isfinite(x.y) & std::isfinite(x.z);
-    p.points[v] = x;
-    if (box) {
-      lo.minimize(q[v]);
-      hi.maximize(q[v]);
+  double lo[2][3] = {{inf, inf, inf}, {inf, inf, inf}};
+  double hi[2][3] = {{-inf, -inf, -inf}, {-inf, -inf, -inf}};
+  const auto add = [&](int half, int v) {
+    const double x = q[v][0], y = q[v][1], z = q[v][2];
+    finite &= std::isfinite(x) & std::isfinite(y) & std::isfinite(z);
+    points[v] = {x, y, z};
+    lo[half][0] = std::min(lo[half][0], x);
+    lo[half][1] = std::min(lo[half][1], y);
+    lo[half][2] = std::min(lo[half][2], z);
+    hi[half][0] = std::max(hi[half][0], x);
+    hi[half][1] = std::max(hi[half][1], y);
+    hi[half][2] = std::max(hi[half][2], z);
+  };
+  int v = 0;
+  for (; v + 1 < n; v += 2) {
+    add(0, v);
+    add(1, v + 1);
+  }
+  if (v < n) add(0, v);
+  bool tie = false;
+  Point box_lo, box_hi;
+  for (int i = 0; i < 3; ++i) {
+    tie |= (lo[0][i] == 0 && lo[1][i] == 0 && std::signbit(lo[0][i]) != std::signbit(lo[1][i])) |
+           (hi[0][i] == 0 && hi[1][i] == 0 && std::signbit(hi[0][i]) != std::signbit(hi[1][i]));
+    box_lo[i] = std::min(lo[0][i], lo[1][i]);
+    box_hi[i] = std::max(hi[0][i], hi[1][i]);
+  }
+  if (tie) {
+    box_lo = Point(inf, inf, inf);
+    box_hi = Point(-inf, -inf, -inf);
+    for (int u = 0; u < n; ++u) {
+      box_lo.minimize(q[u]);
+      box_hi.maximize(q[u]);
     }
   }
-  if (box) *box = {lo, hi};
+  *box = {box_lo, box_hi};
   return finite;
 }
 
@@ -1416,7 +1466,7 @@ std::optional<Polytope> checked_polytope(const Mesh& mesh, const char* name) {
     if (rejected) return;
     try {
       built = finish_from_halfedges(p, std::move(mesh_edge), mesh, name, FaceOrder::as_given,
-                                    units_known, edges_convex, topology.across.data());
+                                    units_known, edges_convex, topology.across.get());
     } catch (...) {
       build_error = std::current_exception();
     }
@@ -1444,7 +1494,7 @@ std::optional<Polytope> checked_polytope(const Mesh& mesh, const char* name) {
     // strictly convex with them where it can, so the build need not test them again.
     walked = walk() && topology.passes;
     if (!walked) return std::nullopt;
-    const FaceCycleView cycles{p.face_begin.data(), p.corner_vertex.data(), topology.across.data()};
+    const FaceCycleView cycles{p.face_begin.data(), p.corner_vertex.data(), topology.across.get()};
     p.unit_normals.resize(p.num_faces());
     passes = geometry_passes(mesh, cycles, p.unit_normals.data(), units_known, edges_convex, &box);
     rejected = !passes;

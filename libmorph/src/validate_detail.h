@@ -5,6 +5,7 @@
 #include <morph/error.h>
 #include <morph/validate.h>
 
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -39,10 +40,12 @@ struct HalfedgeArrays {
     if (mesh.n_faces() > 0)
       face_halfedge = reinterpret_cast<const int*>(&mesh.face(Mesh::FaceHandle(0)));
   }
-  int face(int h) const { return halfedge[4 * h]; }
-  int to(int h) const { return halfedge[4 * h + 1]; }
-  int next(int h) const { return halfedge[4 * h + 2]; }
-  int prev(int h) const { return halfedge[4 * h + 3]; }
+  // The record's offset in 64 bits (one sign extension of h, not one of each 4 h + k).
+  const int* record(int h) const { return halfedge + 4 * static_cast<std::ptrdiff_t>(h); }
+  int face(int h) const { return record(h)[0]; }
+  int to(int h) const { return record(h)[1]; }
+  int next(int h) const { return record(h)[2]; }
+  int prev(int h) const { return record(h)[3]; }
   int from(int h) const { return to(h ^ 1); }
   int halfedge_of_vertex(int v) const { return vertex_halfedge[v]; }
   int halfedge_of_face(int f) const { return face_halfedge[f]; }
