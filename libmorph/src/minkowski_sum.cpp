@@ -918,15 +918,20 @@ LabelledMesh sum_mesh(const Polytope& A, const Polytope& B, const SumFacets& fac
   // assembly then read the points from the other core's cache).
   const int grain = exact ? 1024 : 8192;
   parallel_chunks(static_cast<int>(pairs.size()), grain, [&](int begin, int end) {
-    for (int v = begin; v < end; ++v) {
-      const int i = pair_first(pairs[v]), j = pair_second(pairs[v]);
-      if (!exact) {  // one correctly rounded addition per coordinate
-        const auto& a = A.points[i];
-        const auto& b = B.points[j];
-        points[v] = {a.x + b.x, a.y + b.y, a.z + b.z};
-      } else {
-        points[v] = round_exact_sum(A, i, B, j);
+    // Through local pointers: the stores to the points cannot then be taken for changes to
+    // the arrays' bounds or to `exact`, reloaded at each vertex otherwise.
+    const std::uint64_t* const pair = pairs.data();
+    V3<double>* const point = points.data();
+    if (!exact) {  // one correctly rounded addition per coordinate
+      const V3<double>* const pa = A.points.data();
+      const V3<double>* const pb = B.points.data();
+      for (int v = begin; v < end; ++v) {
+        const V3<double>&a = pa[pair_first(pair[v])], &b = pb[pair_second(pair[v])];
+        point[v] = {a.x + b.x, a.y + b.y, a.z + b.z};
       }
+    } else {
+      for (int v = begin; v < end; ++v)
+        point[v] = round_exact_sum(A, pair_first(pair[v]), B, pair_second(pair[v]));
     }
   });
   std::vector<int> source;
