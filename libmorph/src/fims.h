@@ -44,6 +44,8 @@ void index_vertices(const SumFacets& facets, int num_a, int num_b,
 /// that round to the same point are merged (see docs/algorithm.md, "below double
 /// precision"); facets left with fewer than three vertices are dropped.
 LabelledMesh sum_mesh(const Polytope& A, const Polytope& B, const SumFacets& facets);
+/// The same, taking the facets' origins when each facet is a face of the mesh (no merges).
+LabelledMesh sum_mesh(const Polytope& A, const Polytope& B, SumFacets&& facets);
 
 /// The exact result as a polytope (exact vertex sums), for chaining operations.
 Polytope sum_polytope(const Polytope& A, const Polytope& B, const SumFacets& facets);

@@ -424,6 +424,27 @@ void gather_head(SumFacets& out, BufferLists lists, std::size_t more_faces) {
   append(out, lists);
 }
 
+/// With one thread (one chunk a loop, chunk_loop): room in the head loop's one buffer for
+/// about `faces` facets of four corners, all of the result's, so that take_head can make its
+/// arrays the result's.
+void make_room(std::vector<FacetBuffer>& head, std::size_t faces) {
+  head.resize(1);
+  head[0].corners.reserve(4 * faces);
+  head[0].origins.reserve(faces);
+}
+
+/// gather_head for a head of one buffer made with make_room: its arrays become the result's
+/// (moved rather than copied; their room holds the rest), then `rest` is appended.
+void take_head(SumFacets& out, FacetBuffer& head, BufferLists rest) {
+  out.face_begin.reserve(head.origins.capacity() + 1);
+  out.face_begin.resize(head.sizes.size() + 1);
+  int* begin = out.face_begin.data();
+  for (int size : head.sizes) begin[1] = begin[0] + size, ++begin;
+  out.corners = std::move(head.corners);
+  out.origins = std::move(head.origins);
+  append(out, rest);
+}
+
 }  // namespace
 
 SumFacets fims_facets(const Polytope& A, const Polytope& B) {
@@ -561,11 +582,18 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
     append(out, {&edge});
   } else {
     make_planes_b();
+    const bool one_chunk = tbb::this_task_arena::max_concurrency() == 1;
+    if (one_chunk) make_room(translated, na + nb + edge_estimate);
     in_chunks(chunk_loop(na, kFacetGrain, translated_facets, translated));
     const WalkStarts hints(B, A, loc_a);
     starts = &hints;
     make_planes_a();
-    auto head = [&] { gather_head(out, {&translated}, nb + edge_estimate); };
+    auto head = [&] {
+      if (one_chunk && translated.size() == 1)
+        take_head(out, translated[0], {});
+      else
+        gather_head(out, {&translated}, nb + edge_estimate);
+    };
     in_chunks(chunk_loop(nb, kHintedGrain, corner_facets, corner),
               chunk_loop(A.num_edges(), kEdgeGrain, edge_facets_of, edge), &head);
     append(out, {&corner, &edge});
@@ -595,8 +623,9 @@ int distinct_partners(const int* partner, int b, int e, int* slot, int* out) {
 /// ceil(num_b / 64) words per vertex i, bit j set for each pair (i, j) of a corner (one pass,
 /// no branch per corner). Reading the rows in order lists the pairs sorted by (i, j), so a
 /// pair's number is the bits set before its own (a running count per word, then a bit count
-/// within the word): no search, no sort. `count` counts a word's bits.
-template <class Count>
+/// within the word): no search, no sort. `count` counts a word's bits. `kOneWord`: row is 1
+/// (B has at most 64 vertices), so a pair's word is its vertex of A.
+template <bool kOneWord, class Count>
 [[gnu::always_inline]] inline void index_by_bits(const SumFacets& facets, int num_a, int row,
                                                  std::vector<std::uint64_t>& pairs,
                                                  std::vector<int>& corners, Count count) {
@@ -604,9 +633,12 @@ template <class Count>
   const int num_words = num_a * row;
   std::vector<std::uint64_t> bits(num_words, 0);
   const std::uint64_t* const key = facets.corners.data();
+  const auto word = [row](int i, int j) {
+    return kOneWord ? std::size_t(i) : std::size_t(i) * row + (j >> 6);
+  };
   for (int c = 0; c < nc; ++c) {
     const int i = pair_first(key[c]), j = pair_second(key[c]);
-    bits[std::size_t(i) * row + (j >> 6)] |= std::uint64_t{1} << (j & 63);
+    bits[word(i, j)] |= std::uint64_t{1} << (j & 63);
   }
   // before[w]: the pairs in the words before w.
   const auto before = std::make_unique_for_overwrite<int[]>(num_words);
@@ -625,7 +657,7 @@ template <class Count>
   int* const corner = corners.data();
   for (int c = 0; c < nc; ++c) {
     const int i = pair_first(key[c]), j = pair_second(key[c]);
-    const std::size_t w = std::size_t(i) * row + (j >> 6);
+    const std::size_t w = word(i, j);
     const std::uint64_t below = (std::uint64_t{1} << (j & 63)) - 1;
     corner[c] = before[w] + count(bits[w] & below);
   }
@@ -635,8 +667,13 @@ template <class Count>
 [[gnu::target("popcnt")]] void index_by_bits_popcnt(const SumFacets& facets, int num_a, int row,
                                                     std::vector<std::uint64_t>& pairs,
                                                     std::vector<int>& corners) {
-  index_by_bits(facets, num_a, row, pairs, corners,
-                [](std::uint64_t x) { return __builtin_popcountll(x); });
+  const auto count = [](std::uint64_t x) { return __builtin_popcountll(x); };
+  // A row of one word (B of at most 64 vertices, e.g. the snub dodecahedron): no word
+  // arithmetic per corner.
+  if (row == 1)
+    index_by_bits<true>(facets, num_a, 1, pairs, corners, count);
+  else
+    index_by_bits<false>(facets, num_a, row, pairs, corners, count);
 }
 
 /// index_vertices by bit sets (index_by_bits), when the rows are few for the corners (the
@@ -866,7 +903,11 @@ V3<double> round_exact_sum(const Polytope& A, int i, const Polytope& B, int j) {
 
 }  // namespace
 
-LabelledMesh sum_mesh(const Polytope& A, const Polytope& B, const SumFacets& facets) {
+namespace {
+
+/// sum_mesh; `movable`: facets.origins, when the caller no longer needs them.
+LabelledMesh sum_mesh(const Polytope& A, const Polytope& B, const SumFacets& facets,
+                      std::vector<FacetOrigin>* movable) {
   std::vector<std::uint64_t> pairs;
   std::vector<int> corners;
   index_vertices(facets, A.num_vertices(), B.num_vertices(), pairs, corners);
@@ -877,20 +918,32 @@ LabelledMesh sum_mesh(const Polytope& A, const Polytope& B, const SumFacets& fac
   // assembly then read the points from the other core's cache).
   const int grain = exact ? 1024 : 8192;
   parallel_chunks(static_cast<int>(pairs.size()), grain, [&](int begin, int end) {
-    for (int v = begin; v < end; ++v) {
-      const int i = pair_first(pairs[v]), j = pair_second(pairs[v]);
-      if (!exact) {  // one correctly rounded addition per coordinate
-        const auto& a = A.points[i];
-        const auto& b = B.points[j];
-        points[v] = {a.x + b.x, a.y + b.y, a.z + b.z};
-      } else {
-        points[v] = round_exact_sum(A, i, B, j);
+    // Through local pointers: the stores to the points cannot then be taken for changes to
+    // the arrays' bounds or to `exact`, reloaded at each vertex otherwise.
+    const std::uint64_t* const pair = pairs.data();
+    V3<double>* const point = points.data();
+    if (!exact) {  // one correctly rounded addition per coordinate
+      const V3<double>* const pa = A.points.data();
+      const V3<double>* const pb = B.points.data();
+      for (int v = begin; v < end; ++v) {
+        const V3<double>&a = pa[pair_first(pair[v])], &b = pb[pair_second(pair[v])];
+        point[v] = {a.x + b.x, a.y + b.y, a.z + b.z};
       }
+    } else {
+      for (int v = begin; v < end; ++v)
+        point[v] = round_exact_sum(A, pair_first(pair[v]), B, pair_second(pair[v]));
     }
   });
   std::vector<int> source;
   // Initialised in place: OpenMesh meshes have no move assignment, only a deep copy.
   LabelledMesh out{clean_mesh(points, facets.face_begin, std::move(corners), &source), {}};
+  // Each facet its own face (nothing merged, the usual case): the facets' origins as they are.
+  bool same = movable && source.size() == movable->size();
+  for (std::size_t i = 0; same && i < source.size(); ++i) same = source[i] == static_cast<int>(i);
+  if (same) {
+    out.origins = std::move(*movable);
+    return out;
+  }
   // A face with no source (a triangle of the hull fallback that no facet owns) has no origin.
   // Sized first and written in place (push_back is not inlined: a call per face).
   out.origins.resize(source.size());
@@ -898,6 +951,16 @@ LabelledMesh sum_mesh(const Polytope& A, const Polytope& B, const SumFacets& fac
   for (std::size_t i = 0; i < source.size(); ++i)
     origin[i] = source[i] >= 0 ? facets.origins[source[i]] : FacetOrigin{FacetKind::edge, {}, {}};
   return out;
+}
+
+}  // namespace
+
+LabelledMesh sum_mesh(const Polytope& A, const Polytope& B, const SumFacets& facets) {
+  return sum_mesh(A, B, facets, nullptr);
+}
+
+LabelledMesh sum_mesh(const Polytope& A, const Polytope& B, SumFacets&& facets) {
+  return sum_mesh(A, B, facets, &facets.origins);
 }
 
 Polytope sum_polytope(const Polytope& A, const Polytope& B, const SumFacets& facets) {
