@@ -601,6 +601,42 @@ TEST_CASE("clean_mesh tests the corners of merged polygons only") {
   }
 }
 
+// Pass 2 tests an edge first by one point of the smaller facet off the edge (the one before
+// it), then, if that one is on the larger facet's plane, by all of them: the unit cube's top
+// split at x = 0.6 into a larger part {4, 8, 9, 6} and a smaller one {8, 5, 7, 9}, with one
+// corner of the smaller part lowered (not coplanar) or none (they merge). Lowered 7 (the
+// point before the edge 9 -> 8) fails the first test, lowered 5 only the second.
+TEST_CASE("clean_mesh keeps a facet that one corner keeps off its neighbour's plane") {
+  for (const int lowered : {-1, 5, 7}) {
+    for (const double drop : {1e-3, 1e-6}) {
+      CAPTURE(lowered);
+      CAPTURE(drop);
+      std::vector<V3<double>> points = cube_points();
+      points.push_back({0.6, 0, 1});  // 8
+      points.push_back({0.6, 1, 1});  // 9
+      if (lowered >= 0) points[lowered].z -= drop;
+      const std::vector<std::vector<int>> facets = {
+          {4, 8, 9, 6},     // top, the larger part
+          {0, 1, 5, 8, 4},  // front
+          {8, 5, 7, 9},     // top, the smaller part
+          {2, 6, 9, 7, 3},  // back
+          {0, 2, 3, 1},     // bottom
+          {0, 4, 6, 2},     // left
+          {1, 3, 7, 5},     // right
+      };
+      const auto [mesh, source, hulls] = clean_facets(points, facets);
+      CHECK(hulls == 0);
+      if (lowered < 0) {
+        check_cube(mesh);
+      } else {
+        CHECK(mesh.n_faces() == 7);
+        CHECK(mesh.n_vertices() == 10);
+        CHECK(std::count(source.begin(), source.end(), 2) == 1);
+      }
+    }
+  }
+}
+
 // Several separate merges among many facets that stay as they are (copied in runs): some
 // facets of a sphere polytope are split into fans around their centroid (that vertex goes),
 // and some of those also get the midpoint of an edge, which goes too and so changes the
