@@ -75,7 +75,9 @@ class Ints {
 /// corner's vertex; twin[c] the corner of the opposite edge.
 struct Connectivity {
   Ints face, next, prev, twin;
-  Ints first_out;  // a corner leaving each point (-1: none); `connect`'s is the first one
+  // The last corner (in soup order) leaving each point (-1: none): a vertex's halfedge in
+  // the OpenMesh build, set once per vertex rather than at each of its corners.
+  Ints last_out;
   // `connect`'s only: where each point's outgoing corners start in its counting sort (of
   // num_points + 1 elements), so point v has out_begin[v + 1] - out_begin[v] of them.
   std::vector<int> out_begin;
@@ -168,12 +170,12 @@ bool fixed_fan(const OutCorner* o, int b, int* mark, int* twin) {
 
 /// Twins of every corner, or nothing when the soup is not a closed, oriented 2-manifold
 /// (an edge used twice in one direction or only once, a vertex with several fans).
-/// Also the first corner (in soup order) leaving each point (-1: none).
+/// Also the last corner (in soup order) leaving each point (-1: none).
 std::optional<Connectivity> connect(int num_points, const Soup& soup) {
   const int nc = static_cast<int>(soup.vertex.size());
   Connectivity k = facet_cycles(soup);
   k.twin = Ints(nc);  // each corner's twin is set below (each is the prev of one corner)
-  k.first_out = Ints(num_points);
+  k.last_out = Ints(num_points);
   // Outgoing corners of each vertex (counting sort), each with what its vertex's fan reads
   // of it: the point its edge goes to, and the corner before it (whose edge ends at the
   // vertex) with that corner's point. Read here in corner order, near each other, rather
@@ -205,30 +207,22 @@ std::optional<Connectivity> connect(int num_points, const Soup& soup) {
     // Plain pointers: the writes through them could alias the captured arrays' own pointers.
     const Out* const order = out.get();
     int *twin = k.twin.data(), *place = turn.data(), *mark = edge_to.data();
-    int* const first_out = k.first_out.data();
+    int* const last_out = k.last_out.data();
     const int* const begin = out_begin.data();
     const auto fan = [&](int v) {
       const int b = begin[v], n = begin[v + 1] - b;
       const Out* const o = order + b;
-      first_out[v] = n > 0 ? o[0].corner : -1;
-      switch (n) {  // the usual numbers of corners around a vertex: unrolled
-        case 0:
-          return true;
-        case 3:
-          return fixed_fan<3>(o, b, mark, twin);
-        case 4:
-          return fixed_fan<4>(o, b, mark, twin);
-        case 5:
-          return fixed_fan<5>(o, b, mark, twin);
-        case 6:
-          return fixed_fan<6>(o, b, mark, twin);
-        case 7:
-          return fixed_fan<7>(o, b, mark, twin);
-        case 8:
-          return fixed_fan<8>(o, b, mark, twin);
-        default:
-          break;
-      }
+      last_out[v] = n > 0 ? o[n - 1].corner : -1;  // the sort keeps soup order
+      // The usual numbers of corners around a vertex: unrolled. Tested in a chain, most
+      // frequent first (4 and 3 on sums of quadrilateral-rich and triangulated operands),
+      // rather than by a switch's indirect jump, which was mispredicted more often.
+      if (n == 4) return fixed_fan<4>(o, b, mark, twin);
+      if (n == 3) return fixed_fan<3>(o, b, mark, twin);
+      if (n == 5) return fixed_fan<5>(o, b, mark, twin);
+      if (n == 6) return fixed_fan<6>(o, b, mark, twin);
+      if (n == 0) return true;
+      if (n == 7) return fixed_fan<7>(o, b, mark, twin);
+      if (n == 8) return fixed_fan<8>(o, b, mark, twin);
       for (int i = 0; i < n; ++i) {
         int& e = mark[o[i].to];
         if (e >= b) return false;  // v -> w twice
@@ -667,7 +661,7 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
         keep[v] = n >= 3;
         continue;
       }
-      const int c = k.first_out[v];
+      const int c = k.last_out[v];
       int g1 = -1, g2 = -1, distinct = 0, e = c;
       do {
         const int g = group(e);
@@ -723,7 +717,7 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
   std::vector<char> touched(nf, 0);
   for (int v = 0; v < np; ++v) {
     if (keep[v] || out_begin[v + 1] == out_begin[v]) continue;
-    const int c = k.first_out[v];
+    const int c = k.last_out[v];
     int e = c, steps = 0;
     do {
       touched[k.face[e]] = 1;
@@ -866,12 +860,12 @@ std::optional<Connectivity> connect_with(int num_points, const Soup& soup, Merge
   });
   if (!reverse.load()) return std::nullopt;
   std::vector<int> out_count(num_points, 0), marks(num_points, -1);
-  k.first_out = Ints(num_points);
-  std::fill_n(k.first_out.data(), num_points, -1);
+  k.last_out = Ints(num_points);
+  std::fill_n(k.last_out.data(), num_points, -1);
   // Plain pointers: the writes through them could alias the arrays' own pointers.
   const int *vertex = soup.vertex.data(), *next = k.next.data(), *prev = k.prev.data(),
             *twins = k.twin.data();
-  int *count = out_count.data(), *mark = marks.data(), *leaving = k.first_out.data();
+  int *count = out_count.data(), *mark = marks.data(), *leaving = k.last_out.data();
   const char* check = merged.check_vertex.data();
   for (int c = 0; c < nc; ++c) {
     ++count[vertex[c]];
@@ -992,12 +986,10 @@ Mesh build_parallel(const std::vector<V3<double>>& points, const Soup& soup,
   const int np = static_cast<int>(points.size());
   constexpr int kBlock = 4096;  // corners
   const int nb = (nc + kBlock - 1) / kBlock;
-  std::vector<int> last(np, -1);            // the last corner at each point (-1: unused)
-  std::vector<int> block_edges(nb + 1, 0);  // the first edge of each block
+  const int* const last = k.last_out.data();  // the last corner at each point (-1: unused)
+  std::vector<int> block_edges(nb + 1, 0);    // the first edge of each block
   const int* vertex = soup.vertex.data();
   const int* twin = k.twin.data();
-  // Serial: a plain store per corner (the last one wins), cheaper than any atomic maximum.
-  for (int c = 0; c < nc; ++c) last[vertex[c]] = c;
   parallel_chunks(nb, 1, [&](int first, int end) {
     for (int b = first; b < end; ++b) {
       int n = 0;
@@ -1066,18 +1058,23 @@ Mesh build_serial(const std::vector<V3<double>>& points, const Soup& soup, const
   const int np = static_cast<int>(points.size());
   // The used points are those with a corner leaving them; the corners pair up into edges
   // (twins are mutual and distinct in a closed manifold soup).
-  std::vector<int> handle(np);  // the mesh vertex of each point (-1: unused)
   const int num_edges = nc / 2;
+  const int* const last_out = k.last_out.data();
   int num_used = 0;
-  for (int v = 0; v < np; ++v) handle[v] = k.first_out[v] >= 0 ? num_used++ : -1;
+  for (int v = 0; v < np; ++v) num_used += last_out[v] >= 0;  // counted without a branch
+  // Every point used (a sum's points are its facets' corners, so unless facets merge or
+  // collapse): each point's mesh vertex is its index, and no lookup is needed per corner.
+  const bool all_used = num_used == np;
+  std::vector<int> handle;  // else the mesh vertex of each point (-1: unused)
+  if (!all_used) {
+    handle.resize(np);
+    for (int v = 0, used = 0; v < np; ++v) handle[v] = last_out[v] >= 0 ? used++ : -1;
+  }
   // Every element at once: OpenMesh grows each of its property arrays per added element.
   // The elements are numbered as add_vertex, new_edge and new_face would number them.
   mesh.resize(num_used, num_edges, soup.size());
   // The point array, looked up once (set_point looks its property up by a dynamic_cast).
   Point* point = mesh.property(mesh.points_pph()).data_vector().data();
-  // Every point used (a sum's points are its facets' corners, so unless facets merge or
-  // collapse): each point's mesh vertex is its index, and no lookup is needed per corner.
-  const bool all_used = num_used == np;
   if (all_used)
     for (int v = 0; v < np; ++v) point[v] = Point(points[v].x, points[v].y, points[v].z);
   else
@@ -1111,8 +1108,6 @@ Mesh build_serial(const std::vector<V3<double>>& points, const Soup& soup, const
           mesh.set_vertex_handle(he(c), vh(after(i)));
           mesh.set_vertex_handle(mesh.opposite_halfedge_handle(he(c)), vh(c));
         }
-        // A vertex's halfedge is its last corner's (as when faces are added in order).
-        mesh.set_halfedge_handle(vh(c), he(c));
       }
       const Mesh::FaceHandle fh(f);
       for (int i = 0; i < d; ++i) {
@@ -1135,6 +1130,17 @@ Mesh build_serial(const std::vector<V3<double>>& points, const Soup& soup, const
     fill([&](int c) { return Mesh::VertexHandle(vertex[c]); });
   else
     fill([&](int c) { return Mesh::VertexHandle(handle[vertex[c]]); });
+  // A vertex's halfedge is its last corner's (as when faces are added in order), set once
+  // per vertex rather than at each corner.
+  if (all_used)
+    for (int v = 0; v < np; ++v)
+      mesh.set_halfedge_handle(Mesh::VertexHandle(v),
+                               Mesh::HalfedgeHandle(corner_halfedge[last_out[v]]));
+  else
+    for (int v = 0; v < np; ++v)
+      if (handle[v] >= 0)
+        mesh.set_halfedge_handle(Mesh::VertexHandle(handle[v]),
+                                 Mesh::HalfedgeHandle(corner_halfedge[last_out[v]]));
   return mesh;
 }
 
@@ -1313,7 +1319,7 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
   // into chunks too short to pay at a few thousand facets). They are dropped if not.
   const bool ahead = nf >= kFacetGrain && tbb::this_task_arena::max_concurrency() > 1;
   Prepared pre;
-  UnionFind clusters(n);
+  UnionFind clusters(0);  // of the n points, once needed (nothing is close, usually)
   double limit = 0;
   bool fine = false, any_close = false, as_given = false;
   // Pass 1's search for close corners, and whether the facets are the soup as they are.
@@ -1433,12 +1439,14 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
       if (irregular) some_irregular.store(true, std::memory_order_relaxed);
     });
     any_close = some_close.load();
-    if (any_close)
+    if (any_close) {
+      clusters = UnionFind(n);
       for (int f = 0; f < nf; ++f)
         if (has_close[f])
           for_pairs(f, [&](int u, int w) {
             if (close(u, w)) clusters.unite(u, w);
           });
+    }
     // Nothing merged (the usual case): the facets are the soup as they are, unless one has a
     // repeated corner or fewer than three. Only a facet compared by its sides alone can still
     // have one (the others would have been marked above).
@@ -1469,7 +1477,8 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
     soup.source.resize(nf);
     std::iota(soup.source.begin(), soup.source.end(), 0);
   } else {
-    pre = {};  // found for the facets as given: not the soup
+    pre = {};                                 // found for the facets as given: not the soup
+    if (!any_close) clusters = UnionFind(n);  // each point its own cluster
     Soup merged;
     std::vector<int> last_facet(n, -1);  // the last facet a point was seen in, to find repeats
     merged.vertex.reserve(corners.size());
