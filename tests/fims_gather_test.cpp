@@ -1,10 +1,14 @@
 // fims_facets with one thread, when A has more vertices than B, makes the translated facets'
 // buffer the result's arrays (take_head) rather than copying them (gather_head, with threads);
 // sum_mesh given the facets to keep takes their origins when nothing merges. Both must give
-// what the copying paths give, element for element.
+// what the copying paths give, element for element. And the arenas keep to a caller's cap on
+// TBB's threads.
 #include <doctest/doctest.h>
 #include <morph/minkowski_sum.h>
 #include <morph/structuring_element.h>
+
+#include <tbb/global_control.h>
+#include <tbb/task_arena.h>
 
 #include <cstdint>
 #include <vector>
@@ -79,4 +83,31 @@ TEST_CASE("sum_mesh given its facets gives the same origins for A (+) A") {
   REQUIRE(taken.origins.size() == kept.origins.size());
   CHECK(differing_origins(taken.origins, kept.origins) == 0);
   CHECK(taken.mesh.n_faces() == kept.mesh.n_faces());
+}
+
+// A caller that caps TBB's threads with tbb::global_control: the operations' arenas keep to
+// the cap (their sequential paths, not side-by-side ones with a single thread to run them),
+// and the result is the one without a cap.
+TEST_CASE("run_with_threads keeps to a tbb::global_control cap") {
+  using morph::detail::run_with_threads;
+  const auto concurrency = [] { return tbb::this_task_arena::max_concurrency(); };
+  const int all = concurrency();
+  const morph::Mesh A = morph::make_icosphere(1.0, 3);
+  const morph::Mesh B = morph::make_icosphere(0.5, 2);
+  const morph::LabelledMesh free_sum = morph::minkowski_sum(A, B);
+  {
+    const tbb::global_control cap(tbb::global_control::max_allowed_parallelism, 1);
+    CHECK(run_with_threads(0, concurrency) == 1);
+    CHECK(run_with_threads(4, concurrency) == 1);
+    const morph::LabelledMesh capped = morph::minkowski_sum(A, B);
+    REQUIRE(capped.mesh.n_vertices() == free_sum.mesh.n_vertices());
+    REQUIRE(capped.mesh.n_faces() == free_sum.mesh.n_faces());
+    int differing = 0;
+    for (auto v : free_sum.mesh.vertices())
+      differing += free_sum.mesh.point(v) != capped.mesh.point(v);
+    CHECK(differing == 0);
+    CHECK(differing_origins(capped.origins, free_sum.origins) == 0);
+  }
+  CHECK(run_with_threads(0, concurrency) == all);
+  CHECK(run_with_threads(1, concurrency) == 1);
 }

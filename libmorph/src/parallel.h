@@ -3,6 +3,7 @@
 #pragma once
 
 #include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
@@ -17,13 +18,25 @@
 
 namespace morph::detail {
 
-/// The calling thread's arena of `threads` threads (at most the number of cores), made on
+/// The cap a caller set on TBB's threads with tbb::global_control (max_allowed_parallelism),
+/// or more than any arena has. An arena's max_concurrency does not see it, and the loops that
+/// choose a sequential or a side-by-side path by the arena's count would otherwise take the
+/// side-by-side one with a single thread to run it (each operand's check and build then run one
+/// after the other, the build redoing what the check found: 40% more time).
+inline int global_thread_limit() {
+  return static_cast<int>(std::min<std::size_t>(
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism), 1 << 20));
+}
+
+/// The calling thread's arena of `threads` threads (at most the number of cores and the
+/// global cap), made on
 /// first use and kept: a new arena per operation costs tens of microseconds at two threads
 /// (its worker is requested and woken again each time), a lot for small operands. One per
 /// calling thread, so concurrent callers each get their threads, as with an arena per call.
 inline tbb::task_arena& arena_for(int threads) {
   // More threads than cores buys nothing and makes TBB print a warning.
-  const int n = std::min(threads, tbb::info::default_concurrency());
+  const int n = std::max(
+      1, std::min({threads, tbb::info::default_concurrency(), global_thread_limit()}));
   thread_local std::vector<std::unique_ptr<tbb::task_arena>> arenas;
   if (static_cast<int>(arenas.size()) <= n) arenas.resize(n + 1);
   if (!arenas[n]) arenas[n] = std::make_unique<tbb::task_arena>(n);
@@ -52,11 +65,17 @@ R execute_in_place(tbb::task_arena& arena, F& f) {
   return out;
 }
 
-/// Runs f() with at most `threads` worker threads (0: all cores).
+/// Runs f() with at most `threads` worker threads (0: all cores), and never more than a
+/// tbb::global_control cap allows: f() sees the threads it gets as its arena's concurrency.
 template <class F>
 auto run_with_threads(int threads, F&& f) {
   using R = decltype(f());
-  if (threads <= 0) return f();
+  if (threads <= 0) {
+    // All the calling arena's threads, unless the global cap is below them.
+    const int limit = global_thread_limit();
+    if (limit >= tbb::this_task_arena::max_concurrency()) return f();
+    threads = limit;
+  }
   if constexpr (std::is_void_v<R>)
     return arena_for(threads).execute(std::forward<F>(f));
   else
