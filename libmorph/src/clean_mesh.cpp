@@ -454,10 +454,6 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
   Groups out;
   std::vector<int>& next_member = out.next_member;
   next_member.assign(nf, -1);
-  UnionFind sets(nf);
-  std::vector<int> reference(nf), last_member(nf);
-  std::iota(reference.begin(), reference.end(), 0);
-  std::iota(last_member.begin(), last_member.end(), 0);
   // Plain pointers: loaded once, not through the captures for each test.
   const V3<double>* const point = points.data();
   const int *const vertex = soup.vertex.data(), *const begin = soup.begin.data();
@@ -518,6 +514,17 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
         if (a != b && holds_alone(a, b, edge_b)) passed[block].push_back(c);
       }
   });
+  out.of.resize(nf);
+  if (std::all_of(passed.begin(), passed.end(), [](const auto& b) { return b.empty(); })) {
+    // No edge passed (the usual case): no joins, each facet its own group, and the sets
+    // below are not needed.
+    std::iota(out.of.begin(), out.of.end(), 0);
+    return out;
+  }
+  UnionFind sets(nf);
+  std::vector<int> reference(nf), last_member(nf);
+  std::iota(reference.begin(), reference.end(), 0);
+  std::iota(last_member.begin(), last_member.end(), 0);
   std::vector<char> alone(nf, 1);
   std::priority_queue<int, std::vector<int>, std::greater<>> later;
   // Each facet's edges after `c`, which it joined a group at.
@@ -558,7 +565,6 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
     }
   for (; !later.empty(); later.pop())
     if (later.top() > done) join(done = later.top());
-  out.of.resize(nf);
   for (int f = 0; f < nf; ++f) out.of[f] = sets.find(f);
   return out;
 }

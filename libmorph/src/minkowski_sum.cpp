@@ -504,7 +504,7 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
       for (int f = begin; f < end; ++f) {
         const int start = starts ? out.starts[f - begin] : -1;
         if (start >= 0) hint = start;
-        const bool step = start < 0 && !stayed;
+        const bool step = start < 0 && !stayed && !slots;
         const NormalRef n{P, f};
         loc[f] = slots ? locate(*Q, *slots, n, hint, step) : locate(*Q, planes, n, hint, step);
         const int found = location_vertex(*Q, loc[f]);
@@ -588,12 +588,16 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
     const WalkStarts hints(B, A, loc_a);
     starts = &hints;
     make_planes_a();
-    auto head = [&] {
-      if (one_chunk && translated.size() == 1)
-        take_head(out, translated[0], {});
-      else
-        gather_head(out, {&translated}, nb + edge_estimate);
-    };
+    if (one_chunk && translated.size() == 1 && nb > 0 && A.num_edges() > 0) {
+      // One buffer for all three loops (one chunk each, in order), made the result's at the
+      // end: the corner and edge facets are not copied from buffers of their own.
+      const auto* no_task = static_cast<void (*const*)()>(nullptr);
+      in_chunks(chunk_loop(nb, kHintedGrain, corner_facets, translated),
+                chunk_loop(A.num_edges(), kEdgeGrain, edge_facets_of, translated), no_task);
+      take_head(out, translated[0], {});
+      return out;
+    }
+    auto head = [&] { gather_head(out, {&translated}, nb + edge_estimate); };
     in_chunks(chunk_loop(nb, kHintedGrain, corner_facets, corner),
               chunk_loop(A.num_edges(), kEdgeGrain, edge_facets_of, edge), &head);
     append(out, {&corner, &edge});

@@ -677,10 +677,17 @@ bool triangle_passes(const MeshView& m, const FaceCycles& cycles, int f, const S
 [[gnu::always_inline]] inline bool reflex_across_small(const MeshView& m, const FaceCycles& cycles,
                                                        const PlaneHeight& height,
                                                        const PlaneHeights& heights, Pair tolerances,
-                                                       int g, int from, int to, double tolerance) {
+                                                       int g, int from, int to, int guess,
+                                                       double tolerance) {
   const int gb = cycles.begin[g];
   const int* corners = cycles.vertex + gb;
   const int n = cycles.begin[g + 1] - gb;
+  // A quadrilateral of a grid whose faces all start at the same corner holds the edge at the
+  // caller's guess (the position opposite the edge in the caller's face): no search then.
+  if (n == 4 && corners[guess] == to && corners[(guess + 1) & 3] == from)
+    return !both_at_most(
+        heights(m.points[corners[(guess + 2) & 3]], m.points[corners[(guess + 3) & 3]]),
+        tolerances);
   if (n == 3) {
     const int v = corners[0] != from && corners[0] != to   ? corners[0]
                   : corners[1] != from && corners[1] != to ? corners[1]
@@ -810,10 +817,10 @@ bool quad_passes(const MeshView& m, const FaceCycles& cycles, int f, const Small
   // of the general path's early exit only decides where it stops).
   const int* across = cycles.across + b;
   any_reflex =
-      reflex_across_small(m, cycles, height, heights, tolerances, across[0], i3, i0, tolerance) |
-      reflex_across_small(m, cycles, height, heights, tolerances, across[1], i0, i1, tolerance) |
-      reflex_across_small(m, cycles, height, heights, tolerances, across[2], i1, i2, tolerance) |
-      reflex_across_small(m, cycles, height, heights, tolerances, across[3], i2, i3, tolerance);
+      reflex_across_small(m, cycles, height, heights, tolerances, across[0], i3, i0, 1, tolerance) |
+      reflex_across_small(m, cycles, height, heights, tolerances, across[1], i0, i1, 2, tolerance) |
+      reflex_across_small(m, cycles, height, heights, tolerances, across[2], i1, i2, 3, tolerance) |
+      reflex_across_small(m, cycles, height, heights, tolerances, across[3], i2, i3, 0, tolerance);
   return true;
 }
 
