@@ -147,7 +147,7 @@ bool similar_cycles(const Polytope& P, int f, const Polytope& Q, int g) {
       const V3<double> t = at(r, k) - pp[p[k]];
       if (!(t.x == t0.x && t.y == t0.y && t.z == t0.z)) return false;
     }
-    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    RoundingGuard nearest(CGAL_FE_TONEAREST);
     auto difference = [](const V3<double>& b, const V3<double>& a, DD t[3]) {
       t[0] = two_sum(b.x, -a.x);
       t[1] = two_sum(b.y, -a.y);
@@ -195,7 +195,7 @@ bool similar_cycles(const Polytope& P, int f, const Polytope& Q, int g) {
     // neither normal nor an exact zero.
     const double s = std::ldexp(1.0, e);
     if (!std::isnormal(s)) return false;
-    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    RoundingGuard nearest(CGAL_FE_TONEAREST);
     auto same = [s](double pb, double pa, double qb, double qa) {
       const DD u = two_sum(pb, -pa), v = two_sum(qb, -qa);
       const double hi = u.hi * s, lo = u.lo * s;
@@ -248,7 +248,7 @@ thread_local NearPairs* near_pairs = nullptr;
 
 /// precise_cross (polytope.cpp) in round-to-nearest.
 bool near_cross(const NormalRef& x, const NormalRef& y, double w[3], double& eps) {
-  CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+  RoundingGuard nearest(CGAL_FE_TONEAREST);
   return precise_cross(x, y, w, eps);
 }
 

@@ -77,6 +77,10 @@ ChunkLoop<Body> chunk_loop(int n, int grain, const Body& body, std::vector<Facet
   return {n, tbb::this_task_arena::max_concurrency() == 1 ? std::max(n, 1) : grain, body, &out};
 }
 
+/// in_chunks' `task` when there is none.
+using NoTask = void (*)();
+constexpr const NoTask* kNoTask = nullptr;
+
 /// Runs `task` (unless null) and the chunks of both loops as one parallel loop (one join
 /// for all), each chunk writing its own buffer: the buffers are in loop order, whatever
 /// the schedule.
@@ -110,8 +114,7 @@ void in_chunks(const ChunkLoop<Body1>& one, const ChunkLoop<Body2>& two, const T
 template <class Body>
 void in_chunks(const ChunkLoop<Body>& one) {
   std::vector<FacetBuffer> none;
-  const auto* no_task = static_cast<void (*const*)()>(nullptr);
-  in_chunks(one, chunk_loop(0, 1, one.body, none), no_task);
+  in_chunks(one, chunk_loop(0, 1, one.body, none), kNoTask);
 }
 
 /// The facet of A (+) B whose normal is the normal of facet f of X (X is A when
@@ -591,9 +594,8 @@ SumFacets fims_facets(const Polytope& A, const Polytope& B) {
     if (one_chunk && translated.size() == 1 && nb > 0 && A.num_edges() > 0) {
       // One buffer for all three loops (one chunk each, in order), made the result's at the
       // end: the corner and edge facets are not copied from buffers of their own.
-      const auto* no_task = static_cast<void (*const*)()>(nullptr);
       in_chunks(chunk_loop(nb, kHintedGrain, corner_facets, translated),
-                chunk_loop(A.num_edges(), kEdgeGrain, edge_facets_of, translated), no_task);
+                chunk_loop(A.num_edges(), kEdgeGrain, edge_facets_of, translated), kNoTask);
       take_head(out, translated[0], {});
       return out;
     }
@@ -851,7 +853,7 @@ Homogeneous homogeneous(const Polytope& p, int v) {
 /// on E's exact coordinates, computed on demand): an opening's sums, nearly all decided
 /// without reading an exact point.
 V3<double> round_sum_with_precise(const Polytope& E, int i, const V3<double>& b) {
-  CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+  RoundingGuard nearest(CGAL_FE_TONEAREST);
   const PrecisePoint& p = E.exact_points.precise[i];
   const V3<double>& e = E.points[i];
   if (p.doubles) return {e.x + b.x, e.y + b.y, e.z + b.z};  // E(i) is e: correctly rounded

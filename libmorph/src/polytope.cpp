@@ -421,7 +421,7 @@ int orient_full_stage(const NormalRef& a, const NormalRef& b, const NormalRef& c
 
 int orient_normals_precise(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
   // Double-double needs round-to-nearest, whatever the caller set.
-  CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+  RoundingGuard nearest(CGAL_FE_TONEAREST);
   // A component within the unit normals' error bounds of zero in all three may be exactly
   // zero in all three (mirror-symmetric facets): then det is zero, shown cheaply for
   // triangles by component_surely_zero, else by the full stage.
@@ -457,7 +457,7 @@ int orient_normals_precise(const NormalRef& a, const NormalRef& b, const NormalR
 }
 
 int orient_normals_precise_full(const NormalRef& a, const NormalRef& b, const NormalRef& c) {
-  CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+  RoundingGuard nearest(CGAL_FE_TONEAREST);
   return orient_full_stage(a, b, c);
 }
 
@@ -477,7 +477,7 @@ int cross_dot_normals_precise(const NormalRef& a, const NormalRef& b, const Norm
   {
     // As orient_normals_undecided: double-double on precise normals (nearly parallel
     // normals give values far below what doubles resolve), in round-to-nearest.
-    CGAL::Protect_FPU_rounding<true> nearest(CGAL_FE_TONEAREST);
+    RoundingGuard nearest(CGAL_FE_TONEAREST);
     // First as orient_normals_precise, from the nearly parallel pair's precise normals only
     // (a x b or c x d, whichever pair's unit normals have the larger |dot|; the value is
     // symmetric in the two cross products).
