@@ -27,6 +27,15 @@ namespace {
 
 using namespace morph::detail;
 
+/// The half-space <n, x> <= d for a dyadic d (denominator 1), source 0.
+HalfSpace dyadic_halfspace(const V3<ExactN>& n, const ExactN& d) {
+  HalfSpace h;
+  h.normal() = n;
+  h.offset() = d;
+  h.source = 0;
+  return h;
+}
+
 HalfSpace plane(double nx, double ny, double nz, const Exact& offset, int source) {
   return make_halfspace({ExactN(nx), ExactN(ny), ExactN(nz)}, offset, source);
 }
@@ -455,7 +464,7 @@ std::string input_difference(const ErosionInput& got, const ErosionInput& want) 
     const HalfSpace &g = got.halfspaces[k], &w = want.halfspaces[k];
     if (!same3(g.exact_normal(), w.exact_normal()))
       return "normal " + std::to_string(k) + " differs";
-    if (g.exact_offset() != w.exact_offset() || g.denominator != w.denominator)
+    if (g.exact_offset() != w.exact_offset() || g.denominator() != w.denominator())
       return "offset " + std::to_string(k) + " differs";
     if (g.source != w.source || g.element != w.element)
       return "labels of " + std::to_string(k) + " differ";
@@ -624,7 +633,7 @@ TEST_CASE("halfspace_intersection: an erosion's quadrilateral half-spaces are ex
         const ExactN d = dot(n, to_exact_n(b));
         if (!top_b || d > *top_b) top_b = d;
       }
-      CHECK(h.denominator == ExactN(1));
+      CHECK(h.denominator() == ExactN(1));
       CHECK(h.exact_offset() == *top_a - *top_b);
       for (int j = in.known.begin[f]; j < in.known.begin[f + 1]; ++j) {
         const int k = in.known.point[j];
@@ -682,9 +691,9 @@ TEST_CASE("halfspace_intersection: an erosion's lazy exact planes are the exact 
       ++lazy;
       CHECK(h.has_normal_dd);
       CHECK(h.has_offset_dd);
-      CHECK(h.denominator == ExactN(1));
+      CHECK(h.denominator() == ExactN(1));
       // Not made yet (the input stage reads it only for B's edges and facets along n).
-      if (!h.made.state.load()) CHECK(CGAL::sign(h.offset) == CGAL::ZERO);
+      if (!h.made.state.load()) CHECK(!h.has_exact_values());
     }
     if (c.lazy) CHECK(lazy > 0);
     // Copies, so that nothing is made yet where the input did not make it: four threads
@@ -924,7 +933,7 @@ bool same_double(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0
 HalfSpace plane_through(const V3<double>& n, const V3<ExactN>& p, int scale) {
   const V3<ExactN> m =
       to_exact_n({std::ldexp(n.x, scale), std::ldexp(n.y, scale), std::ldexp(n.z, scale)});
-  return {m, dot(m, p), ExactN(1), 0, -1};
+  return dyadic_halfspace(m, dot(m, p));
 }
 
 /// Three half-spaces through p with normals a, b, c ordered so their det is positive.
@@ -985,7 +994,7 @@ TEST_CASE("halfspace_intersection: the precise stage rounds vertices as the exac
             std::vector<HalfSpace> hs = three_through(n0, n1, n2, p, scale);
             for (HalfSpace& h : hs) {
               double error;
-              const DD d = to_dd(h.offset, error);
+              const DD d = to_dd(h.exact_offset(), error);
               h.has_offset_dd = given && error <= 0x1p-102 * std::abs(d.hi);
               if (h.has_offset_dd) h.offset_dd = d;
             }
@@ -1130,10 +1139,11 @@ std::vector<HalfSpace> moved_fourth(const V3<ExactN>& p, int scale, int q_scale,
   std::vector<HalfSpace> hs =
       three_through({1, 0.25, -0.5}, {-0.3, 1, 0.1}, {0.2, -0.7, 1}, p, scale);
   HalfSpace h = plane_through({0.3, 0.3, 0.9 + 0x1p-30}, p, scale);
-  const double size = std::abs(h.normal.x.to_double() * p.x.to_double()) +
-                      std::abs(h.normal.y.to_double() * p.y.to_double()) +
-                      std::abs(h.normal.z.to_double() * p.z.to_double());
-  h.offset = h.offset + ExactN(std::ldexp(sign * size, -bits));
+  const V3<ExactN>& n = h.exact_normal();
+  const double size = std::abs(n.x.to_double() * p.x.to_double()) +
+                      std::abs(n.y.to_double() * p.y.to_double()) +
+                      std::abs(n.z.to_double() * p.z.to_double());
+  h.offset() = h.exact_offset() + ExactN(std::ldexp(sign * size, -bits));
   hs.push_back(h);
   const double big =
       std::max({std::abs(p.x.to_double()), std::abs(p.y.to_double()), std::abs(p.z.to_double())});
@@ -1163,7 +1173,7 @@ TEST_CASE("halfspace_intersection: the precise determinant sign is exact") {
         const V3<ExactN> n2{n0.x + n1.x + t * e.x, n0.y + n1.y + t * e.y, n0.z + n1.z + t * e.z};
         std::vector<HalfSpace> hs;
         for (const V3<ExactN>& n : {n0, n1, n2})
-          hs.push_back({{n.x * f, n.y * f, n.z * f}, ExactN(1), ExactN(1), 0, -1});
+          hs.push_back(dyadic_halfspace({n.x * f, n.y * f, n.z * f}, ExactN(1)));
         const int want = CGAL::sign(det(n0, n1, n2));
         const PreciseProbe probe = probe_precise(hs);
         if (k == 0) {
@@ -1192,8 +1202,9 @@ TEST_CASE("halfspace_intersection: the precise side and compare signs are exact"
           std::vector<HalfSpace> hs = moved_fourth(p, scale, -scale, bits, sign, q);
           const HalfSpace h = hs[3];
           const PreciseProbe probe = probe_precise(hs);
-          const int want_side = CGAL::sign(dot(h.normal, p) - h.offset);
-          const int want_compare = CGAL::sign(dot(h.normal, p) - dot(h.normal, q));
+          const V3<ExactN>& n = h.exact_normal();
+          const int want_side = CGAL::sign(dot(n, p) - h.exact_offset());
+          const int want_compare = CGAL::sign(dot(n, p) - dot(n, q));
           if (probe.side != 2) CHECK(probe.side == want_side);
           if (probe.compare != 2) CHECK(probe.compare == want_compare);
           decided += (probe.side != 2) + (probe.compare != 2);
@@ -1225,12 +1236,12 @@ TEST_CASE("halfspace_intersection: the double filter's signs are exact") {
   const auto exact_meet = [](const std::vector<HalfSpace>& hs, int first, V3<ExactN>& X,
                              ExactN& W) {
     const HalfSpace &a = hs[first], &b = hs[first + 1], &c = hs[first + 2];
-    W = det(a.normal, b.normal, c.normal);
-    const V3<ExactN> bc = cross(b.normal, c.normal), ca = cross(c.normal, a.normal),
-                     ab = cross(a.normal, b.normal);
-    X = {a.offset * bc.x + b.offset * ca.x + c.offset * ab.x,
-         a.offset * bc.y + b.offset * ca.y + c.offset * ab.y,
-         a.offset * bc.z + b.offset * ca.z + c.offset * ab.z};
+    const V3<ExactN>&na = a.exact_normal(), &nb = b.exact_normal(), &nc = c.exact_normal();
+    const ExactN&da = a.exact_offset(), &db = b.exact_offset(), &dc = c.exact_offset();
+    W = det(na, nb, nc);
+    const V3<ExactN> bc = cross(nb, nc), ca = cross(nc, na), ab = cross(na, nb);
+    X = {da * bc.x + db * ca.x + dc * ab.x, da * bc.y + db * ca.y + dc * ab.y,
+         da * bc.z + db * ca.z + dc * ab.z};
   };
   for (const auto& [p, k] : adversarial_points()) {
     for (int scale : {0, -350, 50, 61}) {
@@ -1245,9 +1256,10 @@ TEST_CASE("halfspace_intersection: the double filter's signs are exact") {
           exact_meet(hs, 4, Xv, Wv);
           const DoubleProbe probe = probe_double(hs);
           if (probe.w == 1) CHECK(CGAL::sign(Wu) > 0);
-          if (probe.side != 2) CHECK(probe.side == CGAL::sign(dot(h.normal, Xu) - h.offset * Wu));
+          const V3<ExactN>& n = h.exact_normal();
+          if (probe.side != 2) CHECK(probe.side == CGAL::sign(dot(n, Xu) - h.exact_offset() * Wu));
           if (probe.compare != 2)
-            CHECK(probe.compare == CGAL::sign(dot(h.normal, Xu) * Wv - dot(h.normal, Xv) * Wu));
+            CHECK(probe.compare == CGAL::sign(dot(n, Xu) * Wv - dot(n, Xv) * Wu));
           decided += (probe.side != 2) + (probe.compare != 2);
           undecided += (probe.side == 2) + (probe.compare == 2);
           if (scale == 61) CHECK(probe.w == 2);  // out of range: left to the intervals
@@ -1562,12 +1574,12 @@ TEST_CASE("halfspace_intersection: a triangle's double-double normal is within i
             p2 = {p0.x, std::nextafter(p0.y, HUGE_VAL), std::nextafter(p0.z, HUGE_VAL)};
           }
           HalfSpace h;
-          h.normal = cross(to_exact_n(p1) - to_exact_n(p0), to_exact_n(p2) - to_exact_n(p0));
+          h.normal() = cross(to_exact_n(p1) - to_exact_n(p0), to_exact_n(p2) - to_exact_n(p0));
           set_normal_dd(h, p0, p1, p2);
           ++total;
           if (!h.has_normal_dd) continue;
           ++set;
-          const ExactN* exact[3] = {&h.normal.x, &h.normal.y, &h.normal.z};
+          const ExactN* exact[3] = {&h.exact_normal().x, &h.exact_normal().y, &h.exact_normal().z};
           for (int k = 0; k < 3; ++k) {
             const DD& d = h.normal_dd[k];
             const Exact diff = Exact(*exact[k]) - Exact(d.hi) - Exact(d.lo);
@@ -1642,4 +1654,38 @@ TEST_CASE("halfspace_intersection: an edge's two far-plane tests are one sign") 
   }
   CHECK(zeros > 0);
   CHECK(zeros < total);
+}
+
+// HalfSpace constructs its exact values only when set or made: a default one reads zero with
+// denominator 1, copies carry the values (or their absence) and the denominator.
+TEST_CASE("halfspace_intersection: half-spaces copy their exact values when they have them") {
+  HalfSpace empty;
+  CHECK(!empty.has_exact_values());
+  CHECK(empty.unit_denominator());
+  CHECK(empty.denominator() == ExactN(1));
+  CHECK(CGAL::sign(empty.exact_offset()) == CGAL::ZERO);
+  CHECK(CGAL::sign(empty.exact_normal().y) == CGAL::ZERO);
+  HalfSpace h = make_halfspace({ExactN(1), ExactN(2), ExactN(3)}, Exact(5) / Exact(3), 7);
+  CHECK(h.has_exact_values());
+  CHECK(!h.unit_denominator());
+  HalfSpace copy = h;
+  CHECK(copy.has_exact_values());
+  CHECK(copy.source == 7);
+  CHECK(copy.exact_normal().z == ExactN(3));
+  CHECK(copy.exact_offset() == ExactN(5));
+  CHECK(copy.denominator() == ExactN(3));
+  // Assigned an empty one: values and denominator go.
+  copy = empty;
+  CHECK(!copy.has_exact_values());
+  CHECK(copy.unit_denominator());
+  CHECK(CGAL::sign(copy.exact_normal().z) == CGAL::ZERO);
+  // An empty one assigned a full one.
+  empty = h;
+  CHECK(empty.has_exact_values());
+  CHECK(empty.exact_normal().y == ExactN(2));
+  CHECK(empty.denominator() == ExactN(3));
+  // A set denominator of 1 reads as a unit one.
+  HalfSpace unit = make_halfspace({ExactN(1), ExactN(0), ExactN(0)}, Exact(4), 0);
+  CHECK(unit.unit_denominator());
+  CHECK(unit.exact_offset() == ExactN(4));
 }

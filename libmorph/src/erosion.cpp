@@ -187,8 +187,9 @@ KnownPoints erosion_points(const Polytope& A, const Polytope& B,
 
 void HalfSpace::set_exact_from_words(const HalfSpace& h) {
   const ExactWords& w = h.words;
-  fixed::set_exact(V3<fixed::i128>{w.n[0], w.n[1], w.n[2]}, w.normal_exp, h.normal);
-  fixed::set_exact(fixed::Int<3>{{w.d[0], w.d[1], w.d[2]}}, w.offset_exp, h.offset);
+  Values& v = h.values();
+  fixed::set_exact(V3<fixed::i128>{w.n[0], w.n[1], w.n[2]}, w.normal_exp, v.normal);
+  fixed::set_exact(fixed::Int<3>{{w.d[0], w.d[1], w.d[2]}}, w.offset_exp, v.offset);
 }
 
 namespace {
@@ -241,8 +242,8 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
             return;
           }
         }
-        n.set_normal(0, h.normal);  // hs's are new: zero
-        h.has_offset_dd = n.set_dot(0, top, &pb, h.offset, &h.offset_dd);
+        n.set_normal(0, h.normal());  // hs's are new: zero
+        h.has_offset_dd = n.set_dot(0, top, &pb, h.offset(), &h.offset_dd);
       };
       if (A.degree(f) == 3 && A.given_normals.empty() && B.exact_points.empty()) {
         // A triangle of double points (A's are then all doubles) and an element of double
@@ -262,8 +263,8 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
           if (!h.has_normal_dd) set_normal_dd(h, p, q, r);
         } else {
           set_normal_dd(h, p, q, r);
-          h.normal = triangle_normal(A, f);
-          h.offset = dot(h.normal, exact_difference(p, pb));
+          h.normal() = triangle_normal(A, f);
+          h.offset() = dot(h.normal(), exact_difference(p, pb));
         }
         add_others_on_plane();
         continue;
@@ -297,18 +298,18 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
           add_others_on_plane();
           continue;
         }
-        h.normal =
+        h.normal() =
             cross(exact_difference(corner(2), corner(0)), exact_difference(corner(3), corner(1)));
         // The sign of h by intervals, exact when they cannot tell.
         int sign;
         {
           RoundingGuard guard;
           sign = interval_sign(
-              dot(to_interval_n(h.normal), to_interval(corner(1)) - to_interval(corner(0))));
+              dot(to_interval_n(h.normal()), to_interval(corner(1)) - to_interval(corner(0))));
         }
-        if (sign == 2) sign = CGAL::sign(dot(h.normal, exact_difference(corner(1), corner(0))));
+        if (sign == 2) sign = CGAL::sign(dot(h.normal(), exact_difference(corner(1), corner(0))));
         const int top = set_top(sign);
-        h.offset = dot(h.normal, exact_difference(corner(top), B.points[b]));
+        h.offset() = dot(h.normal(), exact_difference(corner(top), B.points[b]));
         add_others_on_plane();
         continue;
       }
@@ -336,12 +337,12 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
       for (int c : candidates) {
         if (c != b && same(homogeneous_dot(B, n, c), hb)) others[f].push_back(c);
       }
-      h.normal = n;
+      h.normal() = n;
       if (top.weight == 1 && hb.weight == 1) {
-        h.offset = top.value - hb.value;
+        h.offset() = top.value - hb.value;
       } else {
-        h.offset = top.value * hb.weight - hb.value * top.weight;
-        h.denominator = top.weight * hb.weight;
+        h.offset() = top.value * hb.weight - hb.value * top.weight;
+        h.set_denominator(top.weight * hb.weight);
       }
     }
   });
@@ -462,12 +463,12 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
       }
       HalfSpace& h = hs[g];
       int b = -1;
-      bool found = false;   // h.normal is S's normal n (the faces along n exactly planar)
+      bool found = false;   // h's normal is S's normal n (the faces along n exactly planar)
       bool simple = false;  // translated, corner or parallelogram: n from A's or B's facet
-      // h.offset is <n, a> for a corner (a, b_j) of the facet (see below).
+      // h's offset is <n, a> for a corner (a, b_j) of the facet (see below).
       const V3<double>& a = A.points[i_at(0)];
       bool offset_set = false;
-      // h.normal = 2^doubling (x1 - x0) x (y1 - y0) and h.offset in fixed point
+      // h's normal 2^doubling (x1 - x0) x (y1 - y0) and offset in fixed point
       // (wide_exact.h) when the doubles allow; false when they do not.
       const auto fixed_plane = [&](const V3<double>& x0, const V3<double>& x1, const V3<double>& y0,
                                    const V3<double>& y1, int doubling) {
@@ -475,19 +476,19 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
                                  y0.z, y1.x, y1.y, y1.z, a.x,  a.y,  a.z};
         if (!frame.ok) return false;
         const fixed::Normal n(frame, x0, x1, y0, y1);
-        n.set_normal(doubling, h.normal);  // hs's are new: zero
-        n.set_dot(doubling, a, nullptr, h.offset);
+        n.set_normal(doubling, h.normal());  // hs's are new: zero
+        n.set_dot(doubling, a, nullptr, h.offset());
         offset_set = true;
         return true;
       };
-      // planar_normal into h.normal; a triangle's (its normal (q - p) x (r - p)) in fixed
+      // planar_normal into h's normal; a triangle's (its normal (q - p) x (r - p)) in fixed
       // point first.
       const auto planar = [&](const Polytope& P, int f) {
         if (P.degree(f) == 3) {
           const V3<double>& p = P.points[P.corner(f, 0)];
           if (fixed_plane(p, P.points[P.corner(f, 1)], p, P.points[P.corner(f, 2)], 0)) return true;
         }
-        return planar_normal(P, f, &h.normal);
+        return planar_normal(P, f, &h.normal());
       };
       if (one_j && g < na && same_cycle(A, g, d, i_at)) {
         simple = true;
@@ -523,7 +524,7 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
           if (!fixed_plane(*side[0][0], *side[0][1], *side[1][0], *side[1][1], 1)) {
             const V3<ExactN> m = cross(exact_difference(*side[0][1], *side[0][0]),
                                        exact_difference(*side[1][1], *side[1][0]));
-            h.normal = {m.x + m.x, m.y + m.y, m.z + m.z};
+            h.normal() = {m.x + m.x, m.y + m.y, m.z + m.z};
           }
           found = true;
           b = B.edges[e].from;
@@ -573,7 +574,7 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
           std::vector<V3<ExactN>> cycle(d);
           for (int k = 0; k < d; ++k)
             cycle[k] = to_exact_n(A.points[i_at(k)]) + to_exact_n(B.points[j_at(k)]);
-          h.normal = newell_normal<ExactN>(d, [&](int k) -> const V3<ExactN>& { return cycle[k]; });
+          h.normal() = newell_normal<ExactN>(d, [&](int k) -> const V3<ExactN>& { return cycle[k]; });
           found = true;
         }
       }
@@ -583,7 +584,7 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
       }
       // Every corner (i, j) of the facet lies on its plane, and j on B's face for its normal:
       // h_S - h_B = <n, a_i + b_j> - <n, b_j> = <n, a_i>.
-      if (!offset_set) h.offset = dot(h.normal, to_exact_n(a));
+      if (!offset_set) h.offset() = dot(h.normal(), to_exact_n(a));
       h.source = g;
       h.element = B.vertex_source[b];
       contributing[g] = b;

@@ -172,34 +172,36 @@ std::vector<Plane> planes_of(const std::vector<HalfSpace>& hs) {
     RoundingGuard guard;
     for (int i = begin; i < end; ++i) {
       Plane& p = planes[i];
-      const ExactN& q = hs[i].denominator;
-      if (q == 1) {
-        p.n_exact = &hs[i].normal;
-        p.d_exact = &hs[i].offset;
+      const HalfSpace& h = hs[i];
+      const bool unit = h.unit_denominator();
+      if (unit) {
+        p.n_exact = h.normal_address();
+        p.d_exact = h.offset_address();
       } else {
         // (The offset is the numerator: the plane is the HalfSpace times q.)
+        const ExactN& q = h.denominator();
+        const V3<ExactN>& n = h.exact_normal();
         p.scaled = std::make_shared<const ExactPlane>(
-            ExactPlane{{hs[i].normal.x * q, hs[i].normal.y * q, hs[i].normal.z * q}, hs[i].offset});
+            ExactPlane{{n.x * q, n.y * q, n.z * q}, h.exact_offset()});
         p.n_exact = &p.scaled->n;
         p.d_exact = &p.scaled->d;
       }
-      if (q == 1 && (hs[i].has_normal_dd || hs[i].has_offset_dd)) p.source = &hs[i];
-      if (q == 1 && hs[i].has_normal_dd) {
+      if (unit && (h.has_normal_dd || h.has_offset_dd)) p.source = &h;
+      if (unit && h.has_normal_dd) {
         // The normal's enclosure from its double-double copy (cheaper than from Mpzf).
-        const auto& c = hs[i].normal_dd;
+        const auto& c = h.normal_dd;
         p.ni = {neighbours_interval(c[0]), neighbours_interval(c[1]), neighbours_interval(c[2])};
       } else {
         p.ni = to_interval_n(p.n());
       }
-      p.di = q == 1 && hs[i].has_offset_dd ? neighbours_interval(hs[i].offset_dd)
-                                           : to_interval_n(p.d());
+      p.di = unit && h.has_offset_dd ? neighbours_interval(h.offset_dd) : to_interval_n(p.d());
       set_doubles(p);
     }
   });
   return planes;
 }
 
-Exact rational_offset(const HalfSpace& h) { return Exact(h.exact_offset()) / Exact(h.denominator); }
+Exact rational_offset(const HalfSpace& h) { return Exact(h.exact_offset()) / Exact(h.denominator()); }
 
 /// Chebyshev-like centre for the L1 norm: maximise t subject to
 /// <n_i, x> + |n_i|_1 t <= d_i, t <= 1. t* > 0: a solid (x* strictly inside);
@@ -2607,9 +2609,9 @@ void set_normal_dd(HalfSpace& h, const V3<double>& p0, const V3<double>& p1, con
 
 HalfSpace make_halfspace(const V3<ExactN>& normal, const Exact& offset, int source) {
   HalfSpace h;
-  h.normal = normal;
-  h.offset = integer_n(offset.numerator());
-  h.denominator = integer_n(offset.denominator());
+  h.normal() = normal;
+  h.offset() = integer_n(offset.numerator());
+  h.set_denominator(integer_n(offset.denominator()));
   h.source = source;
   return h;
 }

@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <new>
 #include <optional>
 #include <string>
 
@@ -46,32 +47,64 @@ struct OnceFlag {
 /// (polytopes with double or dyadic points) have denominator 1; a rational offset p/q is
 /// stored as offset p, denominator q (not necessarily reduced). `source` and `element` are carried
 /// to the facets of the result for their labels.
+/// The exact values (five Mpzf, 440 bytes) are constructed only when set or made: an erosion's
+/// thousands of lazy half-spaces, most never read, then cost neither their construction nor
+/// their destruction (the record's other members fit in three cache lines).
 struct HalfSpace {
-  // dyadic: a facet normal of a polytope; becomes the result facet's normal. Read through
-  // exact_normal() and exact_offset(): when `lazy`, both are zero until made from `words`.
-  mutable V3<ExactN> normal;
-  mutable ExactN offset;
-  ExactN denominator = ExactN(1);  // positive
-  int source = -1;                 // erosion: the facet of A (its label)
-  int element = -1;                // erosion: the vertex of B that moved it inwards (its label)
+  int source = -1;   // erosion: the facet of A (its label)
+  int element = -1;  // erosion: the vertex of B that moved it inwards (its label)
   // Optional (set_normal_dd): the normal's components in double-double, each within 2^-101 of
   // its |hi|, |lo| at most half the gap to hi's neighbour on lo's side (round-to-nearest), so
-  // the precise stage and the filters' enclosures need not convert them from `normal`.
+  // the precise stage and the filters' enclosures need not convert them from the normal.
   std::array<DD, 3> normal_dd{};
-  bool has_normal_dd = false;
   // Optional: the offset in double-double within 2^-101 of |hi|, |lo| at most half the gap
   // to hi's neighbour on lo's side (hi rounded to nearest), for a denominator 1: the
   // filters' enclosure (hi's neighbours) and the precise stage's copy of the offset without
   // converting the Mpzf (an erosion makes it from the same fixed-point words).
   DD offset_dd{};
+  bool has_normal_dd = false;
   bool has_offset_dd = false;
   // Lazy exact values (an erosion's fixed-point planes, which then have both double-double
   // copies and denominator 1): normal and offset are made from `words` on first read, by
   // whichever thread reads first (the values do not depend on it, so neither does any
   // decision).
   bool lazy = false;
-  ExactWords words{};
   mutable OnceFlag made;
+  ExactWords words{};
+
+  HalfSpace() = default;
+  HalfSpace(const HalfSpace& o) { *this = o; }
+  HalfSpace& operator=(const HalfSpace& o) {
+    if (this == &o) return *this;
+    source = o.source;
+    element = o.element;
+    normal_dd = o.normal_dd;
+    offset_dd = o.offset_dd;
+    has_normal_dd = o.has_normal_dd;
+    has_offset_dd = o.has_offset_dd;
+    lazy = o.lazy;
+    made = o.made;
+    words = o.words;
+    unit_denominator_ = o.unit_denominator_;
+    if (o.values_)
+      values() = *o.values_;
+    else
+      destroy();
+    return *this;
+  }
+  ~HalfSpace() { destroy(); }
+
+  /// The exact values to set (constructed here, zero, on first use; not for a lazy
+  /// half-space, and not while other threads read it).
+  V3<ExactN>& normal() { return values().normal; }
+  ExactN& offset() { return values().offset; }
+  void set_denominator(const ExactN& q) {
+    values().denominator = q;
+    unit_denominator_ = q == 1;
+  }
+  /// Whether the denominator is 1 (without reading an Mpzf).
+  bool unit_denominator() const { return unit_denominator_; }
+  const ExactN& denominator() const { return unit_denominator_ ? one() : values_->denominator; }
 
   /// Makes normal and offset from `words` when lazy, once (any thread).
   void make_exact() const {
@@ -80,14 +113,57 @@ struct HalfSpace {
   }
   const V3<ExactN>& exact_normal() const {
     make_exact();
-    return normal;
+    return values_ ? values_->normal : zero().normal;
   }
   const ExactN& exact_offset() const {
     make_exact();
-    return offset;
+    return values_ ? values_->offset : zero().offset;
   }
+  /// Where exact_normal() and exact_offset() are, valid to read once make_exact() has run
+  /// (a lazy half-space's storage, before its values are made).
+  const V3<ExactN>* normal_address() const {
+    return values_ || lazy ? &storage()->normal : &zero().normal;
+  }
+  const ExactN* offset_address() const {
+    return values_ || lazy ? &storage()->offset : &zero().offset;
+  }
+  /// Whether the exact values are constructed (set, or made from the words).
+  bool has_exact_values() const { return values_ != nullptr; }
   /// (erosion.cpp: the words made Mpzf into normal and offset, zero before.)
   static void set_exact_from_words(const HalfSpace& h);
+
+ private:
+  struct Values {
+    V3<ExactN> normal;
+    ExactN offset;
+    ExactN denominator = ExactN(1);
+  };
+  static const ExactN& one() {
+    static const ExactN value(1);
+    return value;
+  }
+  static const Values& zero() {
+    static const Values value;
+    return value;
+  }
+  Values* storage() const {
+    return reinterpret_cast<Values*>(const_cast<unsigned char*>(storage_));
+  }
+  /// The values, constructed (zero) on first use.
+  Values& values() const {
+    if (!values_) values_ = new (storage()) Values;
+    return *values_;
+  }
+  void destroy() {
+    if (values_) values_->~Values();
+    values_ = nullptr;
+    unit_denominator_ = true;
+  }
+  bool unit_denominator_ = true;
+  // Set when the storage holds the values (a lazy half-space's in set_exact_from_words,
+  // under `made`; otherwise by the thread that builds the half-space).
+  mutable Values* values_ = nullptr;
+  alignas(Values) unsigned char storage_[sizeof(Values)];
 };
 
 /// Sets h.normal_dd from h.normal = (p1 - p0) x (p2 - p0) for a triangle of double points
