@@ -202,6 +202,15 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
   std::vector<char> on_plane(A.corner_vertex.size(), 0);  // per corner of A
   std::vector<int> contributing(nf);                      // the vertex of B moving f
   std::vector<std::vector<int>> others(nf);               // more vertices of B attaining h_B(N_f)
+  // Each vertex's span (wide_exact.h) for the fixed-point frames below, found once rather
+  // than in each of its facets' frames (about six).
+  std::vector<fixed::Span> spans;
+  if (A.given_normals.empty() && B.exact_points.empty()) {
+    spans.resize(A.num_vertices());
+    parallel_chunks(A.num_vertices(), 1024, [&](int begin, int end) {
+      for (int v = begin; v < end; ++v) spans[v].add(A.points[v]);
+    });
+  }
   parallel_chunks(nf, 64, [&](int begin, int end) {
     std::vector<Homogeneous> dots;
     std::vector<int> candidates;
@@ -256,7 +265,11 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
         // In fixed point (wide_exact.h) when the doubles allow, else in Mpzf: the same values.
         // The normal's and the offset's double-double copies from their exact words (the
         // normal's from the doubles otherwise): cheaper than from the exact values.
-        const fixed::Frame frame{p.x, p.y, p.z, q.x, q.y, q.z, r.x, r.y, r.z, pb.x, pb.y, pb.z};
+        fixed::Span span = spans[A.corner(f, 0)];
+        span.add(spans[A.corner(f, 1)]);
+        span.add(spans[A.corner(f, 2)]);
+        span.add(pb);
+        const fixed::Frame frame(span);
         if (frame.ok) {
           const fixed::Normal n(frame, p, q, p, r);
           set_fixed(n, p, pb);
@@ -289,8 +302,10 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
           return top;
         };
         // In fixed point (wide_exact.h) when the doubles allow.
-        const fixed::Frame frame{p0.x, p0.y, p0.z, p1.x, p1.y, p1.z, p2.x, p2.y,
-                                 p2.z, p3.x, p3.y, p3.z, pb.x, pb.y, pb.z};
+        fixed::Span span = spans[A.corner(f, 0)];
+        for (int k = 1; k < 4; ++k) span.add(spans[A.corner(f, k)]);
+        span.add(pb);
+        const fixed::Frame frame(span);
         if (frame.ok) {
           const fixed::Normal n(frame, p0, p2, p1, p3);
           const int top = set_top(n.sign_dot(p1, p0));

@@ -76,25 +76,44 @@ inline bool exponent_shift_works() {
   return works;
 }
 
+/// What a Frame needs of some doubles: the exponent of their lowest set bit (kNoBits when
+/// all are zero) and the largest magnitude's bit pattern (non-negative doubles order as
+/// their bit patterns; an infinity or a NaN is above every finite one). Spans combine, so a
+/// point's span is found once for all the frames it is in.
+struct Span {
+  static constexpr int kNoBits = 1 << 20;
+  int low = kNoBits;
+  std::uint64_t largest = 0;
+  void add(double d) {
+    std::uint64_t bits;
+    std::memcpy(&bits, &d, sizeof bits);
+    bits &= ~(std::uint64_t{1} << 63);
+    if (bits == 0) return;
+    largest = std::max(largest, bits);
+    const int biased = static_cast<int>(bits >> 52);
+    const std::uint64_t m = biased != 0 ? (bits & kMantissa) | (kMantissa + 1) : bits;
+    low = std::min(low, std::max(biased, 1) - 1075 + __builtin_ctzll(m));
+  }
+  void add(const V3<double>& p) {
+    add(p.x);
+    add(p.y);
+    add(p.z);
+  }
+  void add(const Span& o) {
+    low = std::min(low, o.low);
+    largest = std::max(largest, o.largest);
+  }
+};
+
 /// Doubles scaled by 2^-unit, the smallest power of two of which each is an integer
 /// multiple: each then an integer below 2^kInputBits, or the frame is not ok.
 class Frame {
  public:
-  explicit Frame(std::initializer_list<double> values) {
-    // The lowest set bit of any value, and the largest magnitude (non-negative doubles
-    // order as their bit patterns; an infinity or a NaN is above every finite one).
-    int low = 1 << 20;
-    std::uint64_t largest = 0;
-    for (double d : values) {
-      std::uint64_t bits;
-      std::memcpy(&bits, &d, sizeof bits);
-      bits &= ~(std::uint64_t{1} << 63);
-      if (bits == 0) continue;
-      largest = std::max(largest, bits);
-      const int biased = static_cast<int>(bits >> 52);
-      const std::uint64_t m = biased != 0 ? (bits & kMantissa) | (kMantissa + 1) : bits;
-      low = std::min(low, std::max(biased, 1) - 1075 + __builtin_ctzll(m));
-    }
+  explicit Frame(std::initializer_list<double> values) : Frame(span_of(values)) {}
+  /// The frame of the doubles whose span is `span`.
+  explicit Frame(const Span& span) {
+    const int low = span.low;
+    const std::uint64_t largest = span.largest;
     // Not ok for an infinity or a NaN (or an Mpzf that set_exact cannot make).
     if (largest >= 0x7ff0000000000000 || !exponent_shift_works()) return;
     if (largest == 0) {  // all zero
@@ -131,6 +150,11 @@ class Frame {
   bool small = false;
 
  private:
+  static Span span_of(std::initializer_list<double> values) {
+    Span span;
+    for (double d : values) span.add(d);
+    return span;
+  }
   double scale_ = 1;  // 2^-unit, for a small frame
 };
 
@@ -244,15 +268,20 @@ inline Int<N> widened(i128 x, int words) {
   return r;
 }
 inline Int<3> dot(const V3<i128>& n, const V3<std::int64_t>& d) {
-  // n d = (hi 2^64 + lo) d for the signed high and unsigned low words of n: two products
-  // within 128 bits each.
-  Int<3> r{};
+  // n d = (hi 2^64 + lo) d for the signed high and unsigned low words of n (|n| < 2^126,
+  // |d| < 2^62). Each lo d (below 2^126) is T 2^64 + w for T = lo d >> 64 (below 2^62) and
+  // its low word w: the low words sum in 128 bits (below 3 2^64), hi d + T in one signed
+  // 128-bit sum (below 2^125): a few products and additions, no carry loops.
+  u128 low = 0;
+  i128 high = 0;
   for (const auto& [c, e] : {std::pair{n.x, d.x}, std::pair{n.y, d.y}, std::pair{n.z, d.z}}) {
-    const std::int64_t hi = static_cast<std::int64_t>(c >> 64);
-    const std::uint64_t lo = static_cast<std::uint64_t>(c);
-    r = r + widened<3>(static_cast<i128>(hi) * e, 1) + widened<3>(static_cast<i128>(lo) * e, 0);
+    const i128 t = static_cast<i128>(static_cast<std::uint64_t>(c)) * e;
+    low += static_cast<std::uint64_t>(t);
+    high += (c >> 64) * e + (t >> 64);
   }
-  return r;
+  high += static_cast<i128>(low >> 64);
+  return {{static_cast<std::uint64_t>(low), static_cast<std::uint64_t>(high),
+           static_cast<std::uint64_t>(high >> 64)}};
 }
 /// Sets `out`, a default-constructed Mpzf (zero), to a 2^exp. Mpzf is M 2^(64 k) for an
 /// integer M: |a| shifted by exp mod 64 is made an Mpzf through GMP's read-only view of its
