@@ -25,11 +25,12 @@ struct SumFacets;  // fims.h
 /// 2^126 per component and d a 192-bit two's complement integer, least significant word first.
 /// Most of an intersection's exact planes are never read (the filters decide on the
 /// double-double copies): these become Mpzf on first need (HalfSpace::make_exact).
+/// Set only with HalfSpace::lazy (left uninitialised otherwise: not read, not copied).
 struct ExactWords {
-  std::array<__int128, 3> n{};
-  std::array<std::uint64_t, 3> d{};
-  int normal_exp = 0;
-  int offset_exp = 0;
+  std::array<__int128, 3> n;
+  std::array<std::uint64_t, 3> d;
+  int normal_exp;
+  int offset_exp;
 };
 
 /// A once-flag that a copy of its owner copies (copied only while no thread sets it).
@@ -49,47 +50,61 @@ struct OnceFlag {
 /// to the facets of the result for their labels.
 /// The exact values (five Mpzf, 440 bytes) are constructed only when set or made: an erosion's
 /// thousands of lazy half-spaces, most never read, then cost neither their construction nor
-/// their destruction (the record's other members fit in three cache lines).
+/// their destruction.
 struct HalfSpace {
   int source = -1;   // erosion: the facet of A (its label)
   int element = -1;  // erosion: the vertex of B that moved it inwards (its label)
-  // Optional (set_normal_dd): the normal's components in double-double, each within 2^-101 of
-  // its |hi|, |lo| at most half the gap to hi's neighbour on lo's side (round-to-nearest), so
-  // the precise stage and the filters' enclosures need not convert them from the normal.
-  std::array<DD, 3> normal_dd{};
-  // Optional: the offset in double-double within 2^-101 of |hi|, |lo| at most half the gap
-  // to hi's neighbour on lo's side (hi rounded to nearest), for a denominator 1: the
-  // filters' enclosure (hi's neighbours) and the precise stage's copy of the offset without
-  // converting the Mpzf (an erosion makes it from the same fixed-point words).
-  DD offset_dd{};
-  bool has_normal_dd = false;
-  bool has_offset_dd = false;
+  bool has_normal_dd = false;  // normal_dd is set
+  bool has_offset_dd = false;  // offset_dd is set
   // Lazy exact values (an erosion's fixed-point planes, which then have both double-double
   // copies and denominator 1): normal and offset are made from `words` on first read, by
   // whichever thread reads first (the values do not depend on it, so neither does any
   // decision).
   bool lazy = false;
   mutable OnceFlag made;
-  ExactWords words{};
 
-  HalfSpace() = default;
+ private:
+  struct Values;
+  bool unit_denominator_ = true;
+  // Set when the storage holds the values (a lazy half-space's in set_exact_from_words,
+  // under `made`; otherwise by the thread that builds the half-space).
+  mutable Values* values_ = nullptr;
+
+ public:
+  // The members above are all a new half-space initialises (one cache line: an erosion
+  // makes thousands, on one thread); the copies and words below are read and copied only
+  // where their flags say they are set.
+  // Optional (set_normal_dd): the normal's components in double-double, each within 2^-101 of
+  // its |hi|, |lo| at most half the gap to hi's neighbour on lo's side (round-to-nearest), so
+  // the precise stage and the filters' enclosures need not convert them from the normal.
+  std::array<DD, 3> normal_dd;
+  // Optional: the offset in double-double within 2^-101 of |hi|, |lo| at most half the gap
+  // to hi's neighbour on lo's side (hi rounded to nearest), for a denominator 1: the
+  // filters' enclosure (hi's neighbours) and the precise stage's copy of the offset without
+  // converting the Mpzf (an erosion makes it from the same fixed-point words).
+  DD offset_dd;
+  ExactWords words;  // when lazy
+
+  // User-provided, so that a vector's value-initialisation does not zero the whole record
+  // (the storage and the unset copies) before running it.
+  HalfSpace() {}
   HalfSpace(const HalfSpace& o) { *this = o; }
   HalfSpace& operator=(const HalfSpace& o) {
     if (this == &o) return *this;
     source = o.source;
     element = o.element;
-    normal_dd = o.normal_dd;
-    offset_dd = o.offset_dd;
     has_normal_dd = o.has_normal_dd;
     has_offset_dd = o.has_offset_dd;
     lazy = o.lazy;
     made = o.made;
-    words = o.words;
-    unit_denominator_ = o.unit_denominator_;
+    if (has_normal_dd) normal_dd = o.normal_dd;
+    if (has_offset_dd) offset_dd = o.offset_dd;
+    if (lazy) words = o.words;
     if (o.values_)
       values() = *o.values_;
     else
       destroy();
+    unit_denominator_ = o.unit_denominator_;
     return *this;
   }
   ~HalfSpace() { destroy(); }
@@ -159,10 +174,6 @@ struct HalfSpace {
     values_ = nullptr;
     unit_denominator_ = true;
   }
-  bool unit_denominator_ = true;
-  // Set when the storage holds the values (a lazy half-space's in set_exact_from_words,
-  // under `made`; otherwise by the thread that builds the half-space).
-  mutable Values* values_ = nullptr;
   alignas(Values) unsigned char storage_[sizeof(Values)];
 };
 
