@@ -679,6 +679,13 @@ class PrecisePlanes {
     parallel_chunks(static_cast<int>(planes.size()), 512, [&](int begin, int end) {
       RoundingGuard nearest(CGAL_FE_TONEAREST);
       for (int i = begin; i < end; ++i) {
+        // The half-spaces are large: the hardware does not fetch the next ones in time.
+        if (i + kAhead < end) {
+          if (const HalfSpace* ahead = planes[i + kAhead].source) {
+            __builtin_prefetch(&ahead->normal_dd);
+            __builtin_prefetch(&ahead->offset_dd);
+          }
+        }
         const HalfSpace* h = planes[i].source;
         if (!h || !h->has_normal_dd || !h->has_offset_dd) continue;
         precise_[i] = precise_plane(planes[i]);
@@ -695,6 +702,10 @@ class PrecisePlanes {
   }
   /// Whether plane i's copy is made already (a test that may use it costs no conversion).
   bool made(int i) const { return once_.done(i); }
+  /// Fetches plane i's copy into the cache (no other effect).
+  void prefetch(int i) const { __builtin_prefetch(&precise_[i]); }
+  /// Planes this many ahead are prefetched in the loops over them.
+  static constexpr int kAhead = 4;
 
  private:
   const std::vector<Plane>& planes_;
@@ -1867,8 +1878,12 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   // (A vertex made precise by the flips or the checks above keeps it.)
   parallel_chunks(nv, 128, [&](int begin, int end) {
     RoundingGuard nearest(CGAL_FE_TONEAREST);
-    for (int v = begin; v < end; ++v)
+    for (int v = begin; v < end; ++v) {
+      // Each vertex reads three planes, scattered: those of one a few ahead are fetched now.
+      if (v + PrecisePlanes::kAhead < end)
+        for (const int i : vertex[v + PrecisePlanes::kAhead].planes) precise.prefetch(i);
       if (!vertex[v].precise) make_precise(precise, vertex[v]);
+    }
   });
   LazyExact exact_vertex(planes, vertex);
   const auto side_of = [&](int i, int v) {
