@@ -1189,6 +1189,31 @@ TEST_CASE("halfspace_intersection: the precise determinant sign is exact") {
   CHECK(decided == 24);
 }
 
+// A plane beyond the precise stage's range (its offset above 2^400 times its largest normal
+// component) has no precise copy (PrecisePlane::valid(), read from its normal, which is left
+// zero): its vertices and determinants go to the exact tests; one within the range has one.
+TEST_CASE("halfspace_intersection: planes out of the precise range skip the precise stage") {
+  const V3<ExactN> n0 = to_exact_n({1, 0.25, -0.5}), n1 = to_exact_n({-0.3, 1, 0.1}),
+                   n2 = to_exact_n({0.2, -0.7, 1});
+  const int want = CGAL::sign(det(n0, n1, n2));
+  REQUIRE(want > 0);
+  for (int e : {300, 500}) {
+    std::vector<HalfSpace> hs;
+    for (const V3<ExactN>& n : {n0, n1, n2}) hs.push_back({n, ExactN(1), ExactN(1), 0, -1});
+    hs[1].offset = ExactN(std::ldexp(1.0, e));
+    const PreciseProbe probe = probe_precise(hs);
+    if (e == 300) {
+      CHECK(probe.det == want);
+      CHECK(probe.decided[0]);
+    } else {
+      CHECK(probe.det == 2);
+      CHECK(!probe.decided[0]);
+      CHECK(!probe.decided[1]);
+      CHECK(!probe.decided[2]);
+    }
+  }
+}
+
 // The precise stage of side and compare_along: exact zeros (a fourth plane through the
 // vertex, two vertices on one plane parallel to the fourth) stay undecided, and every
 // sign it decides is the exact sign, down to moves of 2^-90 relative.

@@ -592,17 +592,21 @@ bool split_exactly(const ExactN& x, DD& out) {
 /// A plane's n.x, n.y, n.z, d times a power of two (any positive factor leaves every sign
 /// and every meet unchanged) in double-double: precise_scaled with the largest normal
 /// component in [1, 2), so |d| <= 2^400 and every non-zero component is above 2^-900 (the
-/// precise stage neither overflows nor loses a component). Not `valid` out of that range.
-struct PrecisePlane {
-  std::array<DD, 4> c{};
-  bool valid = false;
+/// precise stage neither overflows nor loses a component). Not valid() out of that range.
+/// One cache line: a vertex reads three planes, scattered (with a flag beside them, 72
+/// bytes, each plane spanned two lines).
+struct alignas(64) PrecisePlane {
+  std::array<DD, 4> c{};  // all zero when not valid (precise_scaled leaves it)
+  /// A valid plane's largest normal component is in [1, 2).
+  bool valid() const { return c[0].hi != 0 || c[1].hi != 0 || c[2].hi != 0; }
 };
+static_assert(sizeof(PrecisePlane) == 64);
 PrecisePlane precise_plane(const Plane& plane) {
   PrecisePlane p;
   const HalfSpace* h = plane.source;
   // (A lazy half-space has both copies: its exact values are not read here.)
   if (h && !(h->has_normal_dd && h->has_offset_dd)) h->make_exact();
-  p.valid = precise_scaled({&plane.n_exact->x, &plane.n_exact->y, &plane.n_exact->z, plane.d_exact},
+  precise_scaled({&plane.n_exact->x, &plane.n_exact->y, &plane.n_exact->z, plane.d_exact},
                            0, 3, p.c, h && h->has_normal_dd ? &h->normal_dd : nullptr,
                            h && h->has_offset_dd ? &h->offset_dd : nullptr);
   return p;
@@ -610,29 +614,37 @@ PrecisePlane precise_plane(const Plane& plane) {
 V3<DD> normal_dd(const PrecisePlane& p) { return {p.c[0], p.c[1], p.c[2]}; }
 V3<Magnitude> normal_magnitude(const PrecisePlane& p) { return magnitude(normal_dd(p)); }
 
-/// n x m in double-double, its operations inlined (these run for most vertices; the
-/// arithmetic is exact.h's, so are the results and bounds).
-[[gnu::flatten]] V3<DD> cross_dd(const V3<DD>& n, const V3<DD>& m) { return cross(n, m); }
-
-/// The precise meet of valid planes a, b, c (round-to-nearest) from their normals' cross
-/// products bc, ca, ab in double-double, each as `cross` evaluates it or that negated (the
-/// same value of the opposite edge, n_b x n_a = -(n_a x n_b): negation is exact, so the
-/// bound below holds alike).
+/// The precise meet of valid planes a, b, c (round-to-nearest): W = <n_a, bc> and
+/// X = d_a bc + n_a x (d_c n_b - d_b n_c), which is Cramer's d_a bc + d_b ca + d_c ab
+/// (n_a x (d_c n_b - d_b n_c) = d_c ab + d_b ca) with two cross products instead of three
+/// (and no edge crosses to share between vertices). Expanded, it has Cramer's monomials, so
+/// the same magnitude, computed here the same way on absolute values; and five levels of
+/// operations as Cramer's (products, differences, products, differences, sums), so the same
+/// evaluation bound.
 [[gnu::flatten]] void precise_meet(const PrecisePlane& a, const PrecisePlane& b,
-                                   const PrecisePlane& c, const V3<DD>& bc, const V3<DD>& ca,
-                                   const V3<DD>& ab, HVertex& v) {
-  meet_of_crosses(normal_dd(a), a.c[3], b.c[3], c.c[3], bc, ca, ab, v.px, v.pw);
-  V3<Magnitude> mx;
-  Magnitude mw;
-  meet(normal_magnitude(a), magnitude(a.c[3]), normal_magnitude(b), magnitude(b.c[3]),
-       normal_magnitude(c), magnitude(c.c[3]), mx, mw);
-  // Degree 3 in the planes' components; underflow in the cross products is multiplied by
-  // at most |d| (no overflow: |n| < 2, |d| <= 2^400).
+                                   const PrecisePlane& c, HVertex& v) {
+  const V3<DD> na = normal_dd(a), nb = normal_dd(b), nc = normal_dd(c);
+  const DD &da = a.c[3], &db = b.c[3], &dc = c.c[3];
+  const V3<DD> bc = cross(nb, nc);
+  const V3<DD> m{dc * nb.x - db * nc.x, dc * nb.y - db * nc.y, dc * nb.z - db * nc.z};
+  const V3<DD> am = cross(na, m);
+  v.pw = dot(na, bc);
+  v.px = {da * bc.x + am.x, da * bc.y + am.y, da * bc.z + am.z};
+  const V3<double> ma{std::abs(na.x.hi), std::abs(na.y.hi), std::abs(na.z.hi)},
+      mb{std::abs(nb.x.hi), std::abs(nb.y.hi), std::abs(nb.z.hi)},
+      mc{std::abs(nc.x.hi), std::abs(nc.y.hi), std::abs(nc.z.hi)};
+  const double mda = std::abs(da.hi), mdb = std::abs(db.hi), mdc = std::abs(dc.hi);
+  const V3<double> mbc = magnitude_cross(mb, mc);
+  const V3<double> mm{mdc * mb.x + mdb * mc.x, mdc * mb.y + mdb * mc.y, mdc * mb.z + mdb * mc.z};
+  const V3<double> mam = magnitude_cross(ma, mm);
+  const double mw = ma.x * mbc.x + ma.y * mbc.y + ma.z * mbc.z;
+  // Degree 3 in the planes' components; underflow in a product is multiplied by at most
+  // |d| or |n| afterwards (no overflow: |n| < 2, |d| <= 2^400).
   constexpr double factor = (3 * kPlaneRelative + kEvaluation) * 1.01;
-  const double absolute =
-      0x1p-960 * (1 + std::abs(a.c[3].hi) + std::abs(b.c[3].hi) + std::abs(c.c[3].hi));
-  v.ex = {factor * mx.x.v + absolute, factor * mx.y.v + absolute, factor * mx.z.v + absolute};
-  v.ew = factor * mw.v + 0x1p-960;
+  const double absolute = 0x1p-960 * (1 + mda + mdb + mdc);
+  v.ex = {factor * (mda * mbc.x + mam.x) + absolute, factor * (mda * mbc.y + mam.y) + absolute,
+          factor * (mda * mbc.z + mam.z) + absolute};
+  v.ew = factor * mw + 0x1p-960;
   v.precise = true;
 }
 
@@ -669,6 +681,13 @@ class PrecisePlanes {
     parallel_chunks(static_cast<int>(planes.size()), 512, [&](int begin, int end) {
       RoundingGuard nearest(CGAL_FE_TONEAREST);
       for (int i = begin; i < end; ++i) {
+        // The half-spaces are large: the hardware does not fetch the next ones in time.
+        if (i + kAhead < end) {
+          if (const HalfSpace* ahead = planes[i + kAhead].source) {
+            __builtin_prefetch(&ahead->normal_dd);
+            __builtin_prefetch(&ahead->offset_dd);
+          }
+        }
         const HalfSpace* h = planes[i].source;
         if (!h || !h->has_normal_dd || !h->has_offset_dd) continue;
         precise_[i] = precise_plane(planes[i]);
@@ -685,6 +704,10 @@ class PrecisePlanes {
   }
   /// Whether plane i's copy is made already (a test that may use it costs no conversion).
   bool made(int i) const { return once_.done(i); }
+  /// Fetches plane i's copy into the cache (no other effect).
+  void prefetch(int i) const { __builtin_prefetch(&precise_[i]); }
+  /// Planes this many ahead are prefetched in the loops over them.
+  static constexpr int kAhead = 4;
 
  private:
   const std::vector<Plane>& planes_;
@@ -693,11 +716,9 @@ class PrecisePlanes {
 };
 
 /// The precise coordinates of a vertex (round-to-nearest): a known point's from its exact
-/// ones (W in [1, 2)), another's as the meet of its precise planes (`crosses`: their
-/// normals' cross products bc, ca, ab when the caller has them, as in precise_meet). Left
-/// out when a plane is not valid or a value out of range.
-void make_precise(const PrecisePlanes& planes, HVertex& v,
-                  const std::array<V3<DD>, 3>* crosses = nullptr) {
+/// ones (W in [1, 2)), another's as the meet of its precise planes. Left out when a plane is
+/// not valid or a value out of range.
+void make_precise(const PrecisePlanes& planes, HVertex& v) {
   v.precise_tried = true;
   if (v.known >= 0) {
     // W = 1 (an erosion's v - b of double points, a closing's exact sums): X is usually
@@ -741,13 +762,8 @@ void make_precise(const PrecisePlanes& planes, HVertex& v,
     return;
   }
   const PrecisePlane &a = planes[v.planes[0]], &b = planes[v.planes[1]], &c = planes[v.planes[2]];
-  if (!a.valid || !b.valid || !c.valid) return;
-  if (crosses) {
-    precise_meet(a, b, c, (*crosses)[0], (*crosses)[1], (*crosses)[2], v);
-    return;
-  }
-  const V3<DD> na = normal_dd(a), nb = normal_dd(b), nc = normal_dd(c);
-  precise_meet(a, b, c, cross_dd(nb, nc), cross_dd(nc, na), cross_dd(na, nb), v);
+  if (!a.valid() || !b.valid() || !c.valid()) return;
+  precise_meet(a, b, c, v);
 }
 
 /// Sign of <n, X> - d W from the precise stage, or 2 (round-to-nearest; both precise).
@@ -835,7 +851,7 @@ int side_filter(const std::vector<Plane>& planes, const PrecisePlanes& precise, 
   const auto precise_sign = [&] {
     RoundingGuard nearest(CGAL_FE_TONEAREST);
     const PrecisePlane& q = precise[i];
-    return q.valid ? precise_side(q, v) : 2;
+    return q.valid() ? precise_side(q, v) : 2;
   };
   if (stage && precise.made(i)) {
     const int t = precise_sign();
@@ -865,7 +881,7 @@ int side(const std::vector<Plane>& planes, const PrecisePlanes& precise, int i, 
     RoundingGuard nearest(CGAL_FE_TONEAREST);
     if (!v.precise_tried) make_precise(precise, v);
     const PrecisePlane& q = precise[i];
-    if (v.precise && q.valid) {
+    if (v.precise && q.valid()) {
       const int t = precise_side(q, v);
       if (t != 2) return t;
     }
@@ -889,7 +905,7 @@ int compare_filter(const std::vector<Plane>& planes, const PrecisePlanes& precis
   const auto precise_sign = [&] {
     RoundingGuard nearest(CGAL_FE_TONEAREST);
     const PrecisePlane& q = precise[i];
-    return q.valid ? precise_compare(q, u, v) : 2;
+    return q.valid() ? precise_compare(q, u, v) : 2;
   };
   const auto interval_sign_of = [&] {
     // (Intervals made here where a vertex has none: not kept, the vertices are shared.)
@@ -1019,8 +1035,7 @@ int det_sign(const Plane& a, const Plane& b, const Plane& c) {
 /// below 2^-53 |hi|).
 int precise_det_sign(const PrecisePlane& a, const PrecisePlane& b, const PrecisePlane& c) {
   HVertex v;
-  const V3<DD> na = normal_dd(a), nb = normal_dd(b), nc = normal_dd(c);
-  precise_meet(a, b, c, cross_dd(nb, nc), cross_dd(nc, na), cross_dd(na, nb), v);
+  precise_meet(a, b, c, v);
   const double bound = 1.01 * v.ew;
   return v.pw.hi > bound ? 1 : v.pw.hi < -bound ? -1 : 2;
 }
@@ -1034,7 +1049,7 @@ int det_sign(const std::vector<Plane>& planes, const PrecisePlanes& precise, int
   {
     RoundingGuard nearest(CGAL_FE_TONEAREST);
     const PrecisePlane &x = precise[a], &y = precise[b], &z = precise[c];
-    const int t = x.valid && y.valid && z.valid ? precise_det_sign(x, y, z) : 2;
+    const int t = x.valid() && y.valid() && z.valid() ? precise_det_sign(x, y, z) : 2;
     if (t != 2) return t;
   }
   return CGAL::sign(det(pa.n(), pb.n(), pc.n()));
@@ -1862,61 +1877,14 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
         if (used[i]) precise[i];
     });
   }
-  // The cross products of precise normals along the edges of the triangles that give the
-  // vertices (`seed`, when made from valid planes): an edge between two such triangles is
-  // computed once, by the smaller one, and taken negated by the other.
-  std::vector<char> from_planes(nt, 0);
-  for (int v = 0; v < nv; ++v) {
-    const HVertex& x = vertex[v];
-    from_planes[seed[v]] = x.known < 0 && !x.precise && x.planes == s.corner[seed[v]] &&
-                           precise[x.planes[0]].valid && precise[x.planes[1]].valid &&
-                           precise[x.planes[2]].valid;
-  }
-  // (Written before read, where from_planes: left uninitialised.)
-  const auto edge_cross =
-      std::make_unique_for_overwrite<V3<DD>[]>(3 * static_cast<std::size_t>(nt));
-  const auto shared = [&](int t, int k) {
-    const int u = s.across[t][k];
-    return from_planes[u] && u < t;
-  };
+  // (A vertex made precise by the flips or the checks above keeps it.)
   parallel_chunks(nv, 128, [&](int begin, int end) {
     RoundingGuard nearest(CGAL_FE_TONEAREST);
     for (int v = begin; v < end; ++v) {
-      const int t = seed[v];
-      if (!from_planes[t]) continue;
-      for (int k = 0; k < 3; ++k)
-        if (!shared(t, k))
-          edge_cross[3 * t + k] = cross_dd(normal_dd(precise[s.corner[t][k]]),
-                                           normal_dd(precise[s.corner[t][k == 2 ? 0 : k + 1]]));
-    }
-  });
-  parallel_chunks(nv, 128, [&](int begin, int end) {
-    RoundingGuard nearest(CGAL_FE_TONEAREST);
-    for (int v = begin; v < end; ++v) {
-      const int t = seed[v];
-      if (!from_planes[t]) {
-        // (A vertex made precise by the flips or the checks above keeps it.)
-        if (!vertex[v].precise) make_precise(precise, vertex[v]);
-      } else {
-        // Edge k runs from corner k to corner k + 1: ab, bc, ca for k = 0, 1, 2.
-        std::array<V3<DD>, 3> along;
-        for (int k = 0; k < 3; ++k) {
-          along[k] = edge_cross[3 * t + k];
-          if (!shared(t, k)) continue;
-          const int u = s.across[t][k], a = s.corner[t][k], b = s.corner[t][k == 2 ? 0 : k + 1];
-          int j = 0;
-          while (j < 3 && s.corner[u][j == 2 ? 0 : j + 1] != a) ++j;
-          // u's edge j is b -> a, across from t (an oriented surface), so u computed it.
-          if (j < 3 && s.corner[u][j] == b && s.across[u][j] == t) {
-            const V3<DD>& c = edge_cross[3 * u + j];
-            along[k] = {-c.x, -c.y, -c.z};
-          } else {
-            along[k] = cross_dd(normal_dd(precise[a]), normal_dd(precise[b]));
-          }
-        }
-        const std::array<V3<DD>, 3> crosses{along[1], along[2], along[0]};
-        make_precise(precise, vertex[v], &crosses);
-      }
+      // Each vertex reads three planes, scattered: those of one a few ahead are fetched now.
+      if (v + PrecisePlanes::kAhead < end)
+        for (const int i : vertex[v + PrecisePlanes::kAhead].planes) precise.prefetch(i);
+      if (!vertex[v].precise) make_precise(precise, vertex[v]);
     }
   });
   LazyExact exact_vertex(planes, vertex);
@@ -2091,17 +2059,10 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     const auto coordinate = [](const auto& p, int i) -> const auto& {
       return i == 0 ? p.x : i == 1 ? p.y : p.z;
     };
-    // The vertices are read in the output's order, scattered over the array: the records a
-    // few ahead are fetched while this one rounds (its flags and precise coordinates span
-    // two cache lines).
-    constexpr int kAhead = 6;
-    for (int r = begin; r < end; ++r) {
-      if (r + kAhead < end) {
-        const HVertex& ahead = vertex[order[r + kAhead]];
-        __builtin_prefetch(&ahead.px);
-        __builtin_prefetch(&ahead.ew);
-      }
-      const HVertex& v = vertex[order[r]];
+    // In the vertices' order, each written to its place in the output's (rank): reading
+    // the records in the output's order missed the cache on most of them.
+    for (int u = begin; u < end; ++u) {
+      const HVertex& v = vertex[u];
       double rounded[3];
       const double inverse = v.precise ? 1 / v.pw.hi : 0;
       for (int i = 0; i < 3; ++i) {
@@ -2116,14 +2077,14 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
         if (v.precise && round_precise(coordinate(v.px, i), coordinate(v.ex, i), v.pw, v.ew,
                                        inverse, rounded[i]))
           continue;
-        const HVertex& e = exact_vertex(order[r]);
+        const HVertex& e = exact_vertex(u);
         // (Any estimate serves: round_quotient only starts from it.)
         const double q = v.intervals ? 0 : coordinate(v.Xd(), i) / v.Wd();
         const Interval estimate =
             v.intervals ? coordinate(v.Xi, i) / v.Wi : Interval(std::isfinite(q) ? q : 0.0);
         rounded[i] = round_quotient(coordinate(*e.X, i), *e.W, estimate);
       }
-      rp.points[r] = {rounded[0], rounded[1], rounded[2]};
+      rp.points[rank[u]] = {rounded[0], rounded[1], rounded[2]};
     }
   });
   rp.face_source.resize(nf);
@@ -2310,7 +2271,7 @@ class IncrementalHull {
         }
       }
       const PrecisePlane& q = precise_[p];
-      if (tri.precise >= 0 && q.valid) {
+      if (tri.precise >= 0 && q.valid()) {
         const int t = precise_side(q, precise_vertex_[tri.precise]);
         if (t != 2) return t;
       }
@@ -2528,9 +2489,9 @@ PreciseProbe probe_precise(const std::vector<HalfSpace>& hs) {
   u.planes = {0, 1, 2};
   make_precise(precise, u);
   probe_rounding(u, out);
-  if (precise[0].valid && precise[1].valid && precise[2].valid)
+  if (precise[0].valid() && precise[1].valid() && precise[2].valid())
     out.det = precise_det_sign(precise[0], precise[1], precise[2]);
-  if (hs.size() < 4 || !u.precise || !precise[3].valid) return out;
+  if (hs.size() < 4 || !u.precise || !precise[3].valid()) return out;
   out.side = precise_side(precise[3], u);
   if (hs.size() < 7) return out;
   HVertex v;
