@@ -913,3 +913,60 @@ TEST_CASE("clean_mesh joins cones of any number of corners around the apex and i
     CHECK(mesh.n_vertices() == static_cast<std::size_t>(2 * n));  // the apex is inside
   }
 }
+
+// Pass 1 takes polygons of five corners or more two at a time when they follow each other,
+// their pairs of corners two at a time, and the soup rebuilt after a merge keeps the
+// geometry of the facets that are as given. A prism over an n-gon whose caps each have an
+// extra corner close to corner k (also a corner of side k, a hexagon): at each place, in
+// either order of the facets, the prism without the hull.
+TEST_CASE("clean_mesh finds close corners at each place of polygons taken two at a time") {
+  for (int n = 5; n <= 12; ++n)
+    for (int k = 0; k < n; ++k)
+      for (const bool caps_first : {true, false}) {
+        CAPTURE(n);
+        CAPTURE(k);
+        CAPTURE(caps_first);
+        std::vector<V3<double>> points;  // bottom 0..n-1, top n..2n-1, extra top, extra bottom
+        for (int z : {-1, 1})
+          for (int i = 0; i < n; ++i) {
+            const double angle = 2 * 3.141592653589793 * i / n;
+            points.push_back({std::cos(angle), std::sin(angle), static_cast<double>(z)});
+          }
+        const int top_extra = 2 * n, bottom_extra = 2 * n + 1, after = (k + 1) % n;
+        for (const int at : {n + k, k}) {
+          const V3<double>& p = points[at];
+          points.push_back({p.x + 1e-13, p.y + 1e-13, p.z});
+        }
+        std::vector<int> top, bottom;
+        for (int i = 0; i < n; ++i) {
+          top.push_back(n + i);
+          if (i == k) top.push_back(top_extra);
+        }
+        for (int i = n - 1; i >= 0; --i) {
+          if (i == k) bottom.push_back(bottom_extra);
+          bottom.push_back(i);
+        }
+        std::vector<std::vector<int>> facets;
+        if (caps_first) facets = {bottom, top};
+        for (int i = 0; i < n; ++i) {
+          const int j = (i + 1) % n;
+          if (i == k)
+            facets.push_back({i, bottom_extra, after, n + after, top_extra, n + i});
+          else
+            facets.push_back({i, j, n + j, n + i});
+        }
+        if (!caps_first) facets.insert(facets.end(), {bottom, top});
+        const auto [mesh, source, hulls] = clean_facets(points, facets);
+        CHECK(hulls == 0);
+        CHECK(mesh.n_vertices() == static_cast<std::size_t>(2 * n));
+        CHECK(mesh.n_edges() == static_cast<std::size_t>(3 * n));
+        REQUIRE(mesh.n_faces() == static_cast<std::size_t>(n + 2));
+        int caps = 0;
+        for (auto f : mesh.faces()) {
+          const auto valence = static_cast<int>(mesh.valence(f));
+          CHECK((valence == 4 || valence == n));
+          caps += valence == n;
+        }
+        CHECK(caps == 2);
+      }
+}

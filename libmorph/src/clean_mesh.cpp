@@ -23,10 +23,12 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <numeric>
 #include <optional>
 #include <queue>
@@ -432,6 +434,61 @@ std::array<bool, 2> geometry_pair(const std::vector<V3<double>>& points, const S
     }
   }
   return apart;
+}
+
+/// `geometry` of facets f and f + 1 at once, one in each lane, for polygons of any degrees
+/// (each lane's operations are `geometry`'s: about half the instructions). The lane of the
+/// facet with fewer corners goes on after its last one with zero offsets, which change
+/// nothing in round-to-nearest (the mode the library runs in): their terms are +0, the
+/// sums, begun at +0, are never -0 (a sum is -0 only of two -0), so adding +0 leaves them,
+/// and the longest edge's maximum with +0 is the maximum (or its NaN) as it was.
+void geometry_pair_any(const std::vector<V3<double>>& points, const Soup& soup, int f,
+                       FacetGeometry* geo) {
+  const int* const begin = soup.begin.data();
+  const int* const u = soup.vertex.data() + begin[f];
+  const int* const w = soup.vertex.data() + begin[f + 1];
+  const int du = begin[f + 1] - begin[f], dw = begin[f + 2] - begin[f + 1];
+  const int both = std::min(du, dw), d = std::max(du, dw);
+  const V3<double>&ou = points[u[0]], &ow = points[w[0]];
+  const V3<Pair> origin{Pair{ou.x, ow.x}, Pair{ou.y, ow.y}, Pair{ou.z, ow.z}};
+  const Pair zero{0, 0};
+  V3<Pair> sum{zero, zero, zero}, centroid{zero, zero, zero}, p{zero, zero, zero};
+  Pair longest_squared = zero;
+  // Offset of corner k of one lane from its first (+0 from its last corner on).
+  const auto offset = [&](const int* v, int dv, int k, const V3<double>& o) {
+    return k < dv ? points[v[k]] - o : V3<double>{0, 0, 0};
+  };
+  for (int k = 0; k < d; ++k) {
+    V3<Pair> q;
+    if (k + 1 < both) {
+      const V3<double>&a = points[u[k + 1]], &b = points[w[k + 1]];
+      q = V3<Pair>{Pair{a.x, b.x}, Pair{a.y, b.y}, Pair{a.z, b.z}} - origin;
+    } else {
+      const V3<double> a = offset(u, du, k + 1, ou), b = offset(w, dw, k + 1, ow);
+      q = V3<Pair>{Pair{a.x, b.x}, Pair{a.y, b.y}, Pair{a.z, b.z}};
+    }
+    sum = sum + cross(p, q);
+    const V3<Pair> e = q - p;
+    longest_squared = pair_max(longest_squared, dot(e, e));
+    centroid = centroid + p;
+    p = q;
+  }
+  const Pair longest = pair_sqrt(longest_squared), area = pair_sqrt(dot(sum, sum));
+  // finish_geometry's operations (x * 0.25 for a quadrilateral is x / 4 there).
+  const V3<Pair> normal{sum.x / area, sum.y / area, sum.z / area};
+  const Pair n{static_cast<double>(du), static_cast<double>(dw)};
+  centroid = {origin.x + centroid.x / n, origin.y + centroid.y / n, origin.z + centroid.z / n};
+  const Pair offsets = dot(normal, centroid);
+  for (int i = 0; i < 2; ++i) {
+    FacetGeometry& g = geo[f + i];
+    g = FacetGeometry{};  // zeros
+    g.longest_edge = longest[i];
+    g.twice_area = area[i];
+    if (g.twice_area > 0) {
+      g.normal = {normal.x[i], normal.y[i], normal.z[i]};
+      g.offset = offsets[i];
+    }
+  }
 }
 
 bool is_thin(const FacetGeometry& g, double limit) {
@@ -915,6 +972,11 @@ void geometries(const std::vector<V3<double>>& points, const Soup& soup, FacetGe
         ++f;
         continue;
       }
+      if (d >= 5 && f + 1 < last && begin[f + 2] - begin[f + 1] >= 5) {
+        geometry_pair_any(points, soup, f, geo);  // two polygons (an erosion's, mostly)
+        ++f;
+        continue;
+      }
       geo[f] = d == 3   ? triangle_geometry(points, soup, f)
                : d == 4 ? quad_geometry(points, soup, f)
                         : geometry(points, soup, f);
@@ -1096,14 +1158,16 @@ Mesh build_serial(const std::vector<V3<double>>& points, const Soup& soup, const
   // One pass, face by face (the corners in order): a face's halfedges are all known after
   // its own corners, as the twins of earlier corners or new edges. `vh`: the mesh vertex
   // of a corner's point.
-  const auto fill = [&](const auto& vh) {
+  // (Always inlined: the pass was inlined or not by how much else the file holds, and a
+  // call left each capture to be loaded again per corner, after the mesh's writes.)
+  const auto fill = [&](const auto& vh) __attribute__((always_inline)) {
     const auto he = [&](int c) { return Mesh::HalfedgeHandle(corner_halfedge[c]); };
     int edge = 0;
     // Face f, of d corners from b (a corner's next is the one after it, or the first after
     // the last). Triangles and quadrilaterals (nearly all faces) take a constant d: their
     // loops are unrolled, as the exits of loops of three or four steps in irregular order
     // were often mispredicted.
-    const auto add_face = [&](int f, int b, auto d) {
+    const auto add_face = [&](int f, int b, auto d) __attribute__((always_inline)) {
       const auto after = [&](int i) { return i + 1 == d ? b : b + i + 1; };
       for (int i = 0; i < d; ++i) {
         const int c = b + i, t = twin[c];
@@ -1404,22 +1468,77 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
       }
       return false;
     };
-    // The facets with close corners (few), found in parallel; their unions follow in order.
-    // A corner repeated in a facet compared pair by pair marks it too (it is close to itself
-    // unless its point is not finite): the facets are then not the soup as they are, and the
-    // unions below are those of close corners either way.
-    std::vector<char> has_close(nf, 0);
+    // Facets of up to kPairwiseDegree corners (an erosion's polygons, mostly): calls
+    // pair(u, w) on the pairs that for_pairs gives from each corner that has one within
+    // `far` (squared) after it — the only pairs that can be close, or repeated when the
+    // points are finite — and returns true; false (nothing called) when a point is not
+    // finite or the facet has more corners. Two pairs at a time from the points loaded once
+    // (the pair by pair test loaded both points of each and branched on it: most of pass 1
+    // on an erosion's polygons). A NaN after the last corner makes the odd pair at the end
+    // never near.
+    auto polygon_pairs = [&](int f, const auto& pair) {
+      const int b = face_begin[f], d = face_begin[f + 1] - b;
+      if (d > kPairwiseDegree) return false;
+      const int* v = corners.data() + b;
+      alignas(16) double x[kPairwiseDegree + 1], y[kPairwiseDegree + 1], z[kPairwiseDegree + 1];
+      double finite = 0;  // 0 * a coordinate: NaN for an infinity or a NaN
+      for (int k = 0; k < d; ++k) {
+        const V3<double>& p = points[v[k]];
+        x[k] = p.x, y[k] = p.y, z[k] = p.z;
+        finite += 0 * p.x + 0 * p.y + 0 * p.z;
+      }
+      if (!(finite == 0)) return false;
+      x[d] = y[d] = z[d] = std::numeric_limits<double>::quiet_NaN();
+      const Pair bound{far, far};
+      unsigned rows = 0;  // bit i: corner i has a pair within `far` after it
+      for (int i = 0; i + 1 < d; ++i) {
+        const Pair xi{x[i], x[i]}, yi{y[i], y[i]}, zi{z[i], z[i]};
+        PairMask near{0, 0};
+        for (int j = i + 1; j < d; j += 2) {
+          // p_i - p_j, as `close` of corners i < j takes it
+          const Pair dx = xi - Pair{x[j], x[j + 1]}, dy = yi - Pair{y[j], y[j + 1]},
+                     dz = zi - Pair{z[j], z[j + 1]};
+          near |= dx * dx + dy * dy + dz * dz <= bound;
+        }
+        rows |= static_cast<unsigned>((near[0] | near[1]) != 0) << i;  // no branch per row
+      }
+      for (; rows != 0; rows &= rows - 1) {  // (few)
+        const int i = std::countr_zero(rows);
+        for (int j = i + 1; j < d; ++j) pair(v[i], v[j]);
+      }
+      return true;
+    };
+    // The close pairs, found in parallel (each chunk's appended under a lock) and united
+    // after: the sets, named by their lowest members, do not depend on the unions' order.
+    // A corner repeated in a facet compared pair by pair counts too (it is close to itself
+    // unless its point is not finite): the facets are then not the soup as they are.
+    std::vector<std::pair<int, int>> close_pairs;
+    std::mutex close_pairs_lock;
     std::atomic<bool> some_close{false};
     // Whether a facet has fewer than three corners or is compared by its sides alone (the
     // facets taken two at a time have three or four).
     std::atomic<bool> some_irregular{false};
     parallel_chunks(nf, kFacetGrain, [&](int first, int last) {
       bool found = false, irregular = false;
+      std::vector<std::pair<int, int>> pairs;  // this chunk's close pairs
+      bool here = false;  // whether the facet tested last has close corners
+      const auto check = [&](int u, int w) {
+        if (u == w || close(u, w)) {
+          here = true;
+          if (u != w) pairs.emplace_back(u, w);
+        }
+      };
       const auto test = [&](int f, bool apart) {
-        bool here = false;
-        if (!apart) for_pairs(f, [&](int u, int w) { here = here || u == w || close(u, w); });
-        has_close[f] = here;
+        here = false;
+        if (!apart) for_pairs(f, check);
         found = found || here;
+      };
+      // A polygon of five corners or more: whether it has close corners.
+      const auto test_polygon = [&](int f) {
+        here = false;
+        if (!polygon_pairs(f, check)) for_pairs(f, check);
+        found = found || here;
+        return here;
       };
       FacetGeometry* const geo = pre.geo.get();
       for (int f = first; f < last; ++f) {
@@ -1434,6 +1553,21 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
           ++f;
           continue;
         }
+        if (d >= 5) {
+          // Polygons (an erosion's, mostly), two at a time when they follow each other. A
+          // facet with close corners is not the soup's as it is: no geometry.
+          const bool pair = f + 1 < last && face_begin[f + 2] - face_begin[f + 1] >= 5;
+          const bool near0 = test_polygon(f), near1 = pair && test_polygon(f + 1);
+          if (pair && !near0 && !near1)
+            geometry_pair_any(points, soup, f, geo);
+          else
+            for (int g = f; g < f + 1 + pair; ++g)
+              if (!(g == f ? near0 : near1)) geo[g] = geometry(points, soup, g);
+          for (int g = f; g < f + 1 + pair; ++g)
+            irregular = irregular || face_begin[g + 1] - face_begin[g] > kPairwiseDegree;
+          f += pair;
+          continue;
+        }
         if (d >= 3)  // (a facet of fewer corners is not the soup's)
           geo[f] = d == 3   ? triangle_geometry(points, soup, f)
                    : d == 4 ? quad_geometry(points, soup, f)
@@ -1442,16 +1576,16 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
         irregular = irregular || d < 3 || d > kPairwiseDegree;
       }
       if (found) some_close.store(true, std::memory_order_relaxed);
+      if (!pairs.empty()) {
+        const std::lock_guard<std::mutex> hold(close_pairs_lock);
+        close_pairs.insert(close_pairs.end(), pairs.begin(), pairs.end());
+      }
       if (irregular) some_irregular.store(true, std::memory_order_relaxed);
     });
     any_close = some_close.load();
     if (any_close) {
       clusters = UnionFind(n);
-      for (int f = 0; f < nf; ++f)
-        if (has_close[f])
-          for_pairs(f, [&](int u, int w) {
-            if (close(u, w)) clusters.unite(u, w);
-          });
+      for (const auto& [u, w] : close_pairs) clusters.unite(u, w);
     }
     // Nothing merged (the usual case): the facets are the soup as they are, unless one has a
     // repeated corner or fewer than three. Only a facet compared by its sides alone can still
@@ -1483,17 +1617,25 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
     soup.source.resize(nf);
     std::iota(soup.source.begin(), soup.source.end(), 0);
   } else {
-    pre = {};                                 // found for the facets as given: not the soup
+    // The connectivity found for the facets as given is not the soup's; their geometry is
+    // that of the soup's facets that are a given facet as it is (the same corners from the
+    // same first one, so the same values): kept for those, computed for the others.
+    const std::unique_ptr<FacetGeometry[]> given_geo = std::move(pre.geo);
+    pre = {};
+    pre.geo = std::make_unique_for_overwrite<FacetGeometry[]>(nf);  // no more facets than given
     if (!any_close) clusters = UnionFind(n);  // each point its own cluster
     Soup merged;
     std::vector<int> last_facet(n, -1);  // the last facet a point was seen in, to find repeats
     merged.vertex.reserve(corners.size());
     merged.source.reserve(nf);
     std::vector<int> cycle, place;  // place: of a point in `cycle` while it is split (-1: none)
+    std::vector<int> changed;       // the soup's facets that are not a given one as it is
     for (int f = 0; f < nf; ++f) {
       cycle.clear();
+      bool moved = false;  // a corner's point merged into another
       for (int c = face_begin[f]; c < face_begin[f + 1]; ++c) {
         const int v = clusters.find(corners[c]);
+        moved = moved || v != corners[c];
         if (cycle.empty() || cycle.back() != v) cycle.push_back(v);
       }
       while (cycle.size() > 1 && cycle.front() == cycle.back()) cycle.pop_back();
@@ -1504,9 +1646,26 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
         last_facet[v] = f;
       }
       if (twice && !(fine && split_collapsed(cycle, place))) repeated = true;
-      if (cycle.size() >= 3) merged.add(cycle, f);
+      if (cycle.size() < 3) continue;
+      // Nothing moved, dropped nor split: the cycle is the facet's corners.
+      if (moved || twice || static_cast<int>(cycle.size()) != face_begin[f + 1] - face_begin[f])
+        changed.push_back(merged.size());
+      else
+        pre.geo[merged.size()] = given_geo[f];
+      merged.add(cycle, f);
     }
     soup = std::move(merged);  // `corners` is not read any more
+    for (std::size_t i = 0; i < changed.size(); ++i) {
+      const int m = changed[i], d = soup.degree(m);
+      if (d >= 5 && i + 1 < changed.size() && changed[i + 1] == m + 1 && soup.degree(m + 1) >= 5) {
+        geometry_pair_any(points, soup, m, pre.geo.get());
+        ++i;
+        continue;
+      }
+      pre.geo[m] = d == 3   ? triangle_geometry(points, soup, m)
+                   : d == 4 ? quad_geometry(points, soup, m)
+                            : geometry(points, soup, m);
+    }
   }
   std::optional<std::pair<Soup, Connectivity>> result;
   if (!repeated) result = simplify(points, soup, limit, true, std::move(pre));
