@@ -1199,8 +1199,8 @@ TEST_CASE("halfspace_intersection: planes out of the precise range skip the prec
   REQUIRE(want > 0);
   for (int e : {300, 500}) {
     std::vector<HalfSpace> hs;
-    for (const V3<ExactN>& n : {n0, n1, n2}) hs.push_back({n, ExactN(1), ExactN(1), 0, -1});
-    hs[1].offset = ExactN(std::ldexp(1.0, e));
+    for (const V3<ExactN>& n : {n0, n1, n2}) hs.push_back(dyadic_halfspace(n, ExactN(1)));
+    hs[1].offset() = ExactN(std::ldexp(1.0, e));
     const PreciseProbe probe = probe_precise(hs);
     if (e == 300) {
       CHECK(probe.det == want);
