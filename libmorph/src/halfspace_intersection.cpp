@@ -1828,14 +1828,18 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   bool adj_made = false;
   if (simple) {
     adj.resize(3 * static_cast<std::size_t>(nt));
-    bool distinct = true;
-    for (int t = 0; t < nt; ++t) {
-      const auto [a, b, c] = sorted_triple(s.across[t]);
-      adj[3 * t] = a;
-      adj[3 * t + 1] = b;
-      adj[3 * t + 2] = c;
-      distinct &= (a < b) & (b < c) & (a != t) & (b != t) & (c != t);
-    }
+    std::atomic<bool> distinct = true;
+    parallel_chunks(nt, 2048, [&](int begin, int end) {
+      bool here = true;
+      for (int t = begin; t < end; ++t) {
+        const auto [a, b, c] = sorted_triple(s.across[t]);
+        adj[3 * t] = a;
+        adj[3 * t + 1] = b;
+        adj[3 * t + 2] = c;
+        here &= (a < b) & (b < c) & (a != t) & (b != t) & (c != t);
+      }
+      if (!here) distinct = false;
+    });
     if (distinct) {
       for (int v = 0; v <= nv; ++v) adj_begin[v] = 3 * v;
       adj_made = true;
@@ -2055,14 +2059,18 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   if (simple && std::all_of(touched.begin(), touched.end(),
                             [](const std::vector<int>& plateau) { return plateau.empty(); })) {
     key.resize(3 * static_cast<std::size_t>(nt));
-    bool distinct = true;
-    for (int t = 0; t < nt; ++t) {
-      const auto [a, b, c] = sorted_triple(s.corner[t]);
-      key[3 * t] = a;
-      key[3 * t + 1] = b;
-      key[3 * t + 2] = c;
-      distinct &= (a < b) & (b < c);
-    }
+    std::atomic<bool> distinct = true;
+    parallel_chunks(nt, 2048, [&](int begin, int end) {
+      bool here = true;
+      for (int t = begin; t < end; ++t) {
+        const auto [a, b, c] = sorted_triple(s.corner[t]);
+        key[3 * t] = a;
+        key[3 * t + 1] = b;
+        key[3 * t + 2] = c;
+        here &= (a < b) & (b < c);
+      }
+      if (!here) distinct = false;
+    });
     if (distinct) {
       for (int v = 0; v <= nv; ++v) key_begin[v] = 3 * v;
       key_made = true;
@@ -2205,7 +2213,10 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   });
   rp.face_source.resize(nf);
   rp.face_element.resize(nf);
+  // (Large half-spaces, each read for two labels: the misses are overlapped.)
+  constexpr int kLabelsAhead = 8;
   for (int f = 0; f < nf; ++f) {
+    if (f + kLabelsAhead < nf) __builtin_prefetch(&hs[face_halfspace[f + kLabelsAhead]].source);
     rp.face_source[f] = hs[face_halfspace[f]].source;
     rp.face_element[f] = hs[face_halfspace[f]].element;
   }
