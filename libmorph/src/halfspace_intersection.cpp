@@ -1239,12 +1239,29 @@ ExactPoints polytope_points(const std::vector<Plane>& planes, std::vector<HVerte
   return exact;
 }
 
+/// a, b, c in increasing order (min and max: no branches).
+std::array<int, 3> sorted_triple(const std::array<int, 3>& x) {
+  const int lo = std::min(x[0], x[1]), hi = std::max(x[0], x[1]);
+  const int mid = std::max(lo, x[2]);
+  return {std::min(lo, x[2]), std::min(hi, mid), std::max(hi, mid)};
+}
+
 /// Sorts each list list[begin[i] .. begin[i + 1]) and drops repeats in it, compacting (the
-/// lists are short: an insertion sort).
+/// lists are short: three elements by sorted_triple, as most are, others by insertion).
 void sort_unique_lists(std::vector<int>& begin, std::vector<int>& list) {
   int kept = 0;
   for (std::size_t i = 0; i + 1 < begin.size(); ++i) {
     const int first = begin[i], last = begin[i + 1];
+    if (last - first == 3) {
+      const auto [a, b, c] = sorted_triple({list[first], list[first + 1], list[first + 2]});
+      begin[i] = kept;
+      list[kept++] = a;
+      list[kept] = b;
+      kept += b != a;
+      list[kept] = c;
+      kept += c != b;
+      continue;
+    }
     for (int j = first + 1; j < last; ++j) {
       const int x = list[j];
       int m = j;
@@ -1781,8 +1798,17 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     return build_verified(hs, planes, precise, known, std::move(s), options, owner, nullptr,
                           &check_ray);
   }
-  std::vector<int> group(nt, -1), seed;
-  {
+  // Group triangles across their coplanar edges (far side 0): each group is a vertex. Usually
+  // every edge is strictly convex (a simple surface: each triangle is its own vertex,
+  // numbered as the search below would), which one scan shows.
+  const bool simple =
+      std::all_of(far_side.begin(), far_side.end(), [](signed char f) { return f < 0; });
+  std::vector<int> group(nt), seed;
+  if (simple) {
+    std::iota(group.begin(), group.end(), 0);
+    seed = group;
+  } else {
+    std::fill(group.begin(), group.end(), -1);
     std::vector<int> stack;
     for (int t0 = 0; t0 < nt; ++t0) {
       if (group[t0] >= 0) continue;
@@ -1812,8 +1838,9 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   // single triangle.
   std::vector<HVertex> vertex;
   if (stored) {
-    for (int g = 0; g < nv; ++g)
-      if (seed[g] != g) s.vertex[g] = std::move(s.vertex[seed[g]]);
+    if (!simple)
+      for (int g = 0; g < nv; ++g)
+        if (seed[g] != g) s.vertex[g] = std::move(s.vertex[seed[g]]);
     s.vertex.resize(nv);
     vertex = std::move(s.vertex);
   } else {
@@ -1825,9 +1852,31 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     });
   }
   // The vertex graph (edges between groups): each vertex's neighbours in increasing order,
-  // once (a counting pass by vertex, then each short list sorted).
+  // once. A simple surface's are the three triangles across, sorted in place when distinct
+  // (and not the triangle itself); otherwise a counting pass by vertex, then each short list
+  // sorted.
   std::vector<int> adj_begin(nv + 1, 0), adj;
-  {
+  bool adj_made = false;
+  if (simple) {
+    adj.resize(3 * static_cast<std::size_t>(nt));
+    std::atomic<bool> distinct = true;
+    parallel_chunks(nt, 2048, [&](int begin, int end) {
+      bool here = true;
+      for (int t = begin; t < end; ++t) {
+        const auto [a, b, c] = sorted_triple(s.across[t]);
+        adj[3 * t] = a;
+        adj[3 * t + 1] = b;
+        adj[3 * t + 2] = c;
+        here &= (a < b) & (b < c) & (a != t) & (b != t) & (c != t);
+      }
+      if (!here) distinct = false;
+    });
+    if (distinct) {
+      for (int v = 0; v <= nv; ++v) adj_begin[v] = 3 * v;
+      adj_made = true;
+    }
+  }
+  if (!adj_made) {
     for (int t = 0; t < nt; ++t)
       for (int k = 0; k < 3; ++k)
         if (group[s.across[t][k]] != group[t]) ++adj_begin[group[t] + 1];
@@ -1847,35 +1896,41 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   // Facet f's cycle of vertices is face_vertex[face_begin[f] .. face_begin[f + 1]).
   // The walk around each plane visits the triangles at it once (a closed surface, checked
   // above): 3 nt entries at most, written by index (push_back was not inlined here).
-  std::vector<int> face_begin(1, 0), face_vertex(3 * static_cast<std::size_t>(nt)), face_halfspace;
-  face_begin.reserve(n + 1);
-  face_halfspace.reserve(n);
+  std::vector<int> face_begin(n + 1), face_vertex(3 * static_cast<std::size_t>(nt)),
+      face_halfspace(n);
+  face_begin[0] = 0;
+  int facets = 0;
   std::size_t used = 0;
   for (int p = 0; p < n; ++p) {
-    if (some_triangle[p] < 0) continue;
+    const int first = some_triangle[p];
+    if (first < 0) continue;
     const std::size_t start = used;
-    int t = some_triangle[p], steps = 0;
+    int t = first, steps = 0;
     do {
       const int g = group[t];
       if (used == start || face_vertex[used - 1] != g) {
         if (used == face_vertex.size()) return std::nullopt;  // (not a closed surface)
         face_vertex[used++] = g;
       }
-      int k = 0;
-      while (k < 3 && s.corner[t][k] != p) ++k;
-      if (k == 3 || ++steps > nt) return std::nullopt;
+      // p's first corner in t, without branches (its place is unpredictable).
+      const auto& c = s.corner[t];
+      const int not0 = c[0] != p;
+      const int k = not0 + (not0 & (c[1] != p));
+      if (c[k] != p || ++steps > nt) return std::nullopt;
       t = s.across[t][k];
-    } while (t != some_triangle[p]);
+    } while (t != first);
     while (used > start + 1 && face_vertex[start] == face_vertex[used - 1]) --used;
     if (used < start + 3) {
       used = start;
       continue;
     }
-    face_begin.push_back(static_cast<int>(used));
-    face_halfspace.push_back(p);
+    face_halfspace[facets] = p;
+    face_begin[++facets] = static_cast<int>(used);
   }
   face_vertex.resize(used);
-  const int nf = static_cast<int>(face_halfspace.size());
+  face_begin.resize(facets + 1);
+  face_halfspace.resize(facets);
+  const int nf = facets;
   if (nf < 4) return std::nullopt;
   // Precise vertices, for the checks below (a second filter stage) and the rounding; exact
   // ones only where those cannot decide (LazyExact; for a polytope computed with further,
@@ -1918,7 +1973,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   for (int p = 0; p < n; ++p)
     if (some_triangle[p] < 0) others.push_back(p);
   std::vector<int> vertex_at_point;  // the vertex that is known point k, or -1
-  if (!known.empty()) {
+  if (!known.empty() && !others.empty()) {
     vertex_at_point.assign(known.X.size(), -1);
     for (int v = 0; v < nv; ++v)
       if (vertex[v].known >= 0) vertex_at_point[vertex[v].known] = v;
@@ -1981,20 +2036,45 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   // Verified. The half-spaces through each vertex (key[key_begin[v] ..), sorted, once):
   // those of its triangles and the touching ones. A touching plane along a whole facet is
   // that facet's plane given twice: the facet takes the smaller index.
+  // A simple surface's vertex without touching planes has its triangle's three corners
+  // (distinct on a valid surface; otherwise the general pass below).
   std::vector<int> key_begin(nv + 1, 0), key;
-  for (int t = 0; t < nt; ++t) key_begin[group[t] + 1] += 3;
-  for (const auto& plateau : touched)
-    for (int v : plateau) ++key_begin[v + 1];
-  std::partial_sum(key_begin.begin(), key_begin.end(), key_begin.begin());
-  key.resize(key_begin[nv]);
-  {
-    std::vector<int> next(key_begin.begin(), key_begin.end() - 1);
-    for (int t = 0; t < nt; ++t)
-      for (int a : s.corner[t]) key[next[group[t]]++] = a;
-    for (std::size_t j = 0; j < others.size(); ++j)
-      for (int v : touched[j]) key[next[v]++] = others[j];
+  bool key_made = false;
+  if (simple && std::all_of(touched.begin(), touched.end(),
+                            [](const std::vector<int>& plateau) { return plateau.empty(); })) {
+    key.resize(3 * static_cast<std::size_t>(nt));
+    std::atomic<bool> distinct = true;
+    parallel_chunks(nt, 2048, [&](int begin, int end) {
+      bool here = true;
+      for (int t = begin; t < end; ++t) {
+        const auto [a, b, c] = sorted_triple(s.corner[t]);
+        key[3 * t] = a;
+        key[3 * t + 1] = b;
+        key[3 * t + 2] = c;
+        here &= (a < b) & (b < c);
+      }
+      if (!here) distinct = false;
+    });
+    if (distinct) {
+      for (int v = 0; v <= nv; ++v) key_begin[v] = 3 * v;
+      key_made = true;
+    }
   }
-  sort_unique_lists(key_begin, key);
+  if (!key_made) {
+    for (int t = 0; t < nt; ++t) key_begin[group[t] + 1] += 3;
+    for (const auto& plateau : touched)
+      for (int v : plateau) ++key_begin[v + 1];
+    std::partial_sum(key_begin.begin(), key_begin.end(), key_begin.begin());
+    key.resize(key_begin[nv]);
+    {
+      std::vector<int> next(key_begin.begin(), key_begin.end() - 1);
+      for (int t = 0; t < nt; ++t)
+        for (int a : s.corner[t]) key[next[group[t]]++] = a;
+      for (std::size_t j = 0; j < others.size(); ++j)
+        for (int v : touched[j]) key[next[v]++] = others[j];
+    }
+    sort_unique_lists(key_begin, key);
+  }
   for (std::size_t j = 0; j < others.size(); ++j) {
     if (touched[j].size() < 3) continue;
     for (int f = 0; f < nf; ++f) {
@@ -2031,22 +2111,29 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   {
     std::vector<int> facet_of(n, -1);  // by half-space
     for (int f = 0; f < nf; ++f) facet_of[face_halfspace[f]] = f;
-    std::vector<int> sorted_begin(1, 0), sorted_vertex(face_vertex.size()), sorted_halfspace;
-    sorted_begin.reserve(nf + 1);
-    sorted_halfspace.reserve(nf);
-    int written = 0;  // (written by index, as face_vertex)
+    std::vector<int> sorted_begin(nf + 1), sorted_vertex(face_vertex.size()), sorted_halfspace(nf);
+    sorted_begin[0] = 0;
+    int sorted = 0, written = 0;
     for (int p = 0; p < n; ++p) {
       const int f = facet_of[p];
       if (f < 0) continue;
-      const int first = written;
-      for (int j = face_begin[f]; j < face_begin[f + 1]; ++j)
-        sorted_vertex[written++] = rank[face_vertex[j]];
-      std::rotate(sorted_vertex.begin() + first,
-                  std::min_element(sorted_vertex.begin() + first, sorted_vertex.begin() + written),
-                  sorted_vertex.begin() + written);
-      sorted_begin.push_back(written);
-      sorted_halfspace.push_back(p);
+      // The cycle from its smallest vertex (the first one if repeated), found without
+      // branches (ranks come in no order).
+      const int first = face_begin[f], size = face_begin[f + 1] - first;
+      int least = rank[face_vertex[first]], at = 0;
+      for (int j = 1; j < size; ++j) {
+        const int r = rank[face_vertex[first + j]];
+        const bool less = r < least;
+        least = less ? r : least;
+        at = less ? j : at;
+      }
+      for (int j = at; j < size; ++j) sorted_vertex[written++] = rank[face_vertex[first + j]];
+      for (int j = 0; j < at; ++j) sorted_vertex[written++] = rank[face_vertex[first + j]];
+      sorted_halfspace[sorted] = p;
+      sorted_begin[++sorted] = written;
     }
+    sorted_begin.resize(sorted + 1);
+    sorted_halfspace.resize(sorted);
     face_begin = std::move(sorted_begin);
     face_vertex = std::move(sorted_vertex);
     face_halfspace = std::move(sorted_halfspace);
@@ -2103,7 +2190,10 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   });
   rp.face_source.resize(nf);
   rp.face_element.resize(nf);
+  // (Large half-spaces, each read for two labels: the misses are overlapped.)
+  constexpr int kLabelsAhead = 8;
   for (int f = 0; f < nf; ++f) {
+    if (f + kLabelsAhead < nf) __builtin_prefetch(&hs[face_halfspace[f + kLabelsAhead]].source);
     rp.face_source[f] = hs[face_halfspace[f]].source;
     rp.face_element[f] = hs[face_halfspace[f]].element;
   }
