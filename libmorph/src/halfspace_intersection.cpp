@@ -1384,6 +1384,17 @@ bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& preci
   RoundingGuard guard;
   const int nt = static_cast<int>(s.corner.size());
   std::vector<char> dead(nt, 0), changed(nt, 0);
+  // The far-plane signs of the repair's own tests, for the check after it: per slot, the
+  // far plane tested (-1: none, or the triangle changed since) and its sign.
+  std::vector<int> tested_far(3 * static_cast<std::size_t>(nt), -1);
+  std::vector<signed char> tested_sign(3 * static_cast<std::size_t>(nt));
+  const auto record = [&](int t, int k, int far, int sign) {
+    tested_far[3 * t + k] = far;
+    tested_sign[3 * t + k] = static_cast<signed char>(sign);
+  };
+  const auto forget = [&](int t) {
+    for (int k = 0; k < 3; ++k) tested_far[3 * t + k] = -1;
+  };
   const auto next = [](int k) { return k == 2 ? 0 : k + 1; };
   const auto prev = [](int k) { return k == 0 ? 2 : k - 1; };
   const auto slot_of = [&](int t, int a) {
@@ -1446,6 +1457,7 @@ bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& preci
     changed[t] = 1;
     s.corner[t] = {y, z, d};
     s.across[t] = {X, Z, Y};
+    forget(t);
     s.has_vertex[t] = 0;
     dead[u] = dead[w] = 1;
     push_edges(t);
@@ -1473,7 +1485,15 @@ bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& preci
     HVertex& v = vertex_at(t);
     // (W > 0: a known point, or the meet of positively oriented planes; independent_vertex_of
     // and the checks' side tests assume the same.)
-    if (known_through(known, d, v) || side(planes, precise, d, v) <= 0) continue;
+    {
+      const int sd = known_through(known, d, v) ? 0 : side(planes, precise, d, v);
+      if (sd <= 0) {
+        // (Plane b at u's vertex has the same sign: see build_verified's far-plane tests.)
+        record(t, i, d, sd);
+        record(u, j, b, sd);
+        continue;
+      }
+    }
     if (--budget < 0) return false;
     const int X1 = s.across[t][next(i)], X2 = s.across[t][prev(i)], Y1 = s.across[u][next(j)],
               Y2 = s.across[u][prev(j)];
@@ -1490,6 +1510,12 @@ bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& preci
       s.across[t] = {Y1, u, X2};
       s.corner[u] = {d, c, b};
       s.across[u] = {Y2, X1, t};
+      // The new diagonal's sign is the opposite of the test that flipped it (its four
+      // planes in an odd order), as in triangulate_polygon.
+      forget(t);
+      forget(u);
+      record(t, 1, c, -1);
+      record(u, 2, a, -1);
       s.has_vertex[t] = s.has_vertex[u] = 0;
       changed[t] = changed[u] = 1;
       queue.push_back({t, b, a});
@@ -1506,25 +1532,48 @@ bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& preci
     ++budget;
     waiting.push_back({t, a, c});
   }
-  // Drop the removed triangles.
+  // Drop the removed triangles: those beyond the kept count fill the removed ones' slots
+  // below it (fewer vertex moves than shifting all later ones; the check's result does not
+  // depend on the triangles' order).
   std::vector<int> index(nt, -1);
   int kept = 0;
-  for (int t = 0; t < nt; ++t)
-    if (!dead[t]) index[t] = kept++;
+  for (int t = 0; t < nt; ++t) kept += !dead[t];
+  for (int t = 0, hole = 0; t < nt; ++t) {
+    if (dead[t]) continue;
+    if (t < kept) {
+      index[t] = t;
+    } else {
+      while (!dead[hole]) ++hole;
+      index[t] = hole++;
+    }
+  }
   for (int& t : s.near) {
     // (A triangle removed since: its dual point's neighbour, still near.)
     if (t >= 0 && dead[t]) t = s.across[t][0];
     if (t >= 0) t = index[t];
   }
-  // The far-plane signs stay for the edges between unchanged triangles.
+  // The far-plane signs stay for the edges between unchanged triangles, and the repair's
+  // own where the far plane is still the one tested (the same four planes).
   std::vector<signed char> far_side(3 * static_cast<std::size_t>(kept), 2);
-  for (int t = 0; t < nt; ++t)
-    if (!dead[t] && !changed[t])
-      for (int k = 0; k < 3; ++k)
-        if (!changed[s.across[t][k]]) far_side[3 * index[t] + k] = s.far_side[3 * t + k];
+  for (int t = 0; t < nt; ++t) {
+    if (dead[t]) continue;
+    for (int k = 0; k < 3; ++k) {
+      const int u = s.across[t][k];
+      if (!changed[t] && !changed[u]) {
+        far_side[3 * index[t] + k] = s.far_side[3 * t + k];
+      } else if (tested_far[3 * t + k] >= 0) {
+        const int a = s.corner[t][k], b = s.corner[t][next(k)];
+        int far = -1;
+        for (int c : s.corner[u])
+          if (c != a && c != b) far = c;
+        if (far == tested_far[3 * t + k]) far_side[3 * index[t] + k] = tested_sign[3 * t + k];
+      }
+    }
+  }
   s.far_side = std::move(far_side);
   s.oriented = true;
   for (int t = 0; t < nt; ++t) {
+    // (Each slot is written once, from itself or from a kept triangle beyond `kept`.)
     if (dead[t]) continue;
     const int r = index[t];
     s.corner[r] = s.corner[t];
@@ -2770,16 +2819,17 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
   }
   ready.assign(triangle.size(), 0);
   // All planes fast (the usual case): the vertices are the double filter's (double_meet).
+  // (Their doubles copied on the way: one pass over the scattered planes.)
   bool fast = true;
-  for (int i = 0; i < k; ++i) fast = fast && planes[p[i]].fast;
-  if (fast) {
-    scratch.nd.resize(k);
-    scratch.na.resize(k);
-    for (int i = 0; i < k; ++i) {
-      scratch.nd[i] = planes[p[i]].nd;
-      scratch.na[i] = planes[p[i]].na();
-    }
-  } else {
+  scratch.nd.resize(k);
+  scratch.na.resize(k);
+  for (int i = 0; i < k; ++i) {
+    const Plane& plane = planes[p[i]];
+    fast = fast && plane.fast;
+    scratch.nd[i] = plane.nd;
+    scratch.na[i] = plane.na();
+  }
+  if (!fast) {
     scratch.cross.resize(static_cast<std::size_t>(k) * k);
     scratch.has_cross.assign(static_cast<std::size_t>(k) * k, 0);
   }
@@ -2937,7 +2987,7 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
     out[t] = {p[triangle[t][0]], p[triangle[t][1]], p[triangle[t][2]]};
     for (int m = 0; m < 3; ++m) {
       const int x = triangle[t][m], y = triangle[t][m == 2 ? 0 : m + 1];
-      out_far[3 * t + m] = diagonal(x, y) ? diagonal_side(x, y) : 2;
+      out_far[3 * t + m] = diagonal_side(x, y);  // (2 for the polygon's sides: never set)
     }
     if (!ready[t]) compute_vertex(static_cast<int>(t));
     out_has[t] = 1;
@@ -2990,8 +3040,12 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const PrecisePlan
   // search finds exactly one, every edge b -> a with b > a is reached, and there are as many
   // of those as of the searching ones (then the searches pair them one to one).
   const auto next_corner = [](int k) { return k == 2 ? 0 : k + 1; };
-  std::vector<int> out_begin(planes.size() + 1, 0), out_edge(3 * static_cast<std::size_t>(nt)),
-      out_head(out_edge.size());
+  // (Each edge's head beside it: a search reads one array. Not zeroed: all are written.)
+  struct OutEdge {
+    int head, edge;
+  };
+  std::vector<int> out_begin(planes.size() + 1, 0);
+  const auto out = std::make_unique_for_overwrite<OutEdge[]>(3 * static_cast<std::size_t>(nt));
   std::ptrdiff_t balance = 0;  // edges a -> b with a < b, less those with a > b
   for (const auto& c : s.corner)
     for (int k = 0; k < 3; ++k) {
@@ -3006,9 +3060,7 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const PrecisePlan
     std::vector<int> next(out_begin.begin(), out_begin.end() - 1);
     for (int t = 0; t < nt; ++t)
       for (int k = 0; k < 3; ++k) {
-        const int j = next[s.corner[t][k]]++;
-        out_edge[j] = 3 * t + k;
-        out_head[j] = s.corner[t][next_corner(k)];
+        out[next[s.corner[t][k]]++] = {s.corner[t][next_corner(k)], 3 * t + k};
       }
   }
   s.across.assign(nt, {-1, -1, -1});
@@ -3019,7 +3071,7 @@ DualSurface expected_surface(const std::vector<Plane>& planes, const PrecisePlan
         if (a > b) continue;  // set by its reverse's search
         int back = -1, found = 0;
         for (int j = out_begin[b]; j < out_begin[b + 1]; ++j)
-          if (out_head[j] == a) back = out_edge[j], ++found;
+          if (out[j].head == a) back = out[j].edge, ++found;
         if (found != 1) {
           ok = false;  // an open surface, or an edge used twice
           break;
