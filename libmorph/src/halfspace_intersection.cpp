@@ -675,7 +675,7 @@ V3<Magnitude> normal_magnitude(const PrecisePlane& p) { return magnitude(normal_
 ///    |s_i| <= |p_i| + 7 u M_i), 8 u (|p_i| + D_i) + 128 u^2 M_i in all; the planes err by
 ///    2^-100 (M_i + D_i) (|x| <= |x0| + |delta|); underflow stays below 2^-950. E_i =
 ///    8 u (|p_i| + D_i) + (128 u^2 + 2^-100) (M_i + D_i) + 2^-950.
-/// The factor 1.01 covers the (1 + 2^-50) and the rounding of the bound's own evaluation.
+/// The factor 1.01 covers the rounding of the bound's own evaluation (and of 1 / w_low).
 /// The ranges: |N| < 2 and |d| <= 2^400 (valid planes), |x0| <= 2^400 checked, so no
 /// product overflows or loses its split; x's components are zero or in [2^-900, 2^400], as
 /// precise_scaled's, for the tests that read px.
