@@ -1046,6 +1046,90 @@ TEST_CASE("halfspace_intersection: the precise stage rounds vertices as the exac
   CHECK(!probe_precise_point({ExactN(1), ExactN(1), ExactN(1)}, huge).decided[0]);
 }
 
+// The precise vertex of three planes by a Newton step from doubles (newton_meet: X / W itself
+// with an a-posteriori bound from its residual): well-conditioned triples take it, triples
+// nearly dependent (the third normal 2^-45 from the first) fall back to the double-double
+// Cramer's rule, and either way ties are never decided and what is decided is the exact
+// rounding: near-midpoint points of very different sizes, normals scaled by 2^+-200,
+// growing ill-conditioning, and vertices beyond the range (|x| > 2^400) or with zero
+// coordinates.
+TEST_CASE("halfspace_intersection: the Newton precise vertex rounds as the exact rounding") {
+  const V3<double> n0{1, 0.25, -0.5}, n1{-0.3, 1, 0.1}, n2{0.2, -0.7, 1};
+  int newton = 0, fallback = 0, decided = 0;
+  for (const auto& [p, k] : adversarial_points()) {
+    for (int scale : {0, -200, 200}) {
+      for (int tilt : {0, 8, 16, 24, 45}) {
+        const double t = std::ldexp(1.0, -tilt);
+        const V3<double> third = tilt == 0 ? n2 : V3<double>{n0.x + t, n0.y - t, n0.z + t / 3};
+        const PreciseProbe probe = probe_precise(three_through(n0, n1, third, p, scale));
+        if (tilt == 0) CHECK(probe.newton);
+        if (tilt == 45) CHECK(!probe.newton);
+        newton += probe.newton;
+        fallback += !probe.newton;
+        const ExactN* c[3] = {&p.x, &p.y, &p.z};
+        const double got[3] = {probe.rounded.x, probe.rounded.y, probe.rounded.z};
+        for (int i = 0; i < 3; ++i) {
+          if (k == 1 || k >= 60) CHECK(!probe.decided[i]);
+          if (!probe.decided[i]) continue;
+          ++decided;
+          CHECK(same_double(got[i], rounded_exactly(*c[i])));
+        }
+      }
+    }
+  }
+  CHECK(newton > 100);
+  CHECK(fallback > 100);
+  CHECK(decided > 100);
+  // Zero coordinates (left to the exact rounding) and the range's ends: 2^400 and beyond.
+  for (const double big : {0.0, 0x1p399 * 1.5, 0x1p401}) {
+    const V3<ExactN> p{ExactN(big), ExactN(0.75), ExactN(0)};
+    const PreciseProbe probe = probe_precise(three_through(n0, n1, n2, p, 0));
+    CHECK(probe.newton == (big < 0x1p400));
+    CHECK(!probe.decided[2]);
+    if (probe.decided[0]) CHECK(same_double(probe.rounded.x, big));
+    if (probe.decided[1]) CHECK(same_double(probe.rounded.y, 0.75));
+  }
+}
+
+// Precise coordinates with W = 1 exactly (the Newton vertex's; also an opening's sums from
+// them) round by X.hi when X.lo and the error stay strictly inside the half gaps to X.hi's
+// neighbours: next to powers of two of either sign (the gaps differ by 2), lo on, just
+// inside and just outside each half gap, with errors that reach across or not.
+TEST_CASE("halfspace_intersection: precise coordinates with W = 1 round exactly") {
+  int decided = 0, declined = 0;
+  for (int e : {0, 1, -1, 52, 200, -200}) {
+    for (double sign : {1.0, -1.0}) {
+      for (int odd : {0, 1}) {
+        const double m = std::ldexp(1.0, e), x = sign * (odd ? std::nextafter(m, HUGE_VAL) : m);
+        const double ax = std::abs(x);
+        const double away = std::nextafter(ax, HUGE_VAL) - ax, toward = ax - std::nextafter(ax, 0.0);
+        for (double half : {away / 2, -toward / 2}) {
+          for (int k : {0, 20, 60}) {  // lo 2^-k of the gap inside the midpoint (0: on it)
+            const double lo = sign * (half - (half > 0 ? 1 : -1) * (k ? std::ldexp(away, -k) : 0));
+            for (int f : {10, 30, 70, 200}) {  // the error, 2^-f of the gap
+              const double error = std::ldexp(away, -f);
+              double got;
+              const bool ok = round_precise_sum({x, lo}, error, {1, 0}, 0, 0.0, got);
+              const ExactN v = ExactN(x) + ExactN(lo);
+              const bool reaches = k == 0 || f <= k;  // the error reaches the midpoint
+              if (reaches) CHECK(!ok);
+              if (!ok) {
+                ++declined;
+                continue;
+              }
+              ++decided;
+              CHECK(same_double(got, rounded_exactly(v)));
+              CHECK(same_double(got, x));
+            }
+          }
+        }
+      }
+    }
+  }
+  CHECK(decided > 100);
+  CHECK(declined > 100);
+}
+
 // Next to a power of two the gap to the neighbour towards zero is half the gap away from
 // it (the rounding steps to both neighbours by the bits of r): points on and just off the
 // midpoints on either side, of either sign, and just off the power itself, decided only as

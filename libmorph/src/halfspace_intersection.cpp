@@ -530,6 +530,9 @@ constexpr double kEvaluation = 32 * kU2;  // (b)
 /// Relative error of each component of a precise plane (a).
 constexpr double kPlaneRelative = 0x1p-100;
 
+/// newton_meet's largest accepted bound, relative to the vertex's largest coordinate.
+constexpr double kNewtonAccepted = 0x1p-80;
+
 /// Four exact values in double-double, each within kPlaneRelative of |hi|, all scaled by
 /// the power of two that brings the largest |c[k]|, k in [lead_begin, lead_end), into
 /// [1, 2); false when a value is beyond 2^400 or a non-zero one below 2^-900 after that
@@ -648,6 +651,105 @@ V3<Magnitude> normal_magnitude(const PrecisePlane& p) { return magnitude(normal_
   v.precise = true;
 }
 
+/// The vertex of valid planes a, b, c as x = X / W itself (px = x, pw = 1, ew = 0: the
+/// rounding is then one comparison per coordinate), by one Newton step from Cramer's rule in
+/// doubles, fewer operations than precise_meet; false (v untouched) when its bound
+/// is not small or a value out of range (round-to-nearest). With the normals' highs N_i (rows
+/// of J), x0 = J^-1 d in doubles, s_i = d_i - <n_i, x0> in double-double, delta = J^-1 s in
+/// doubles, x = x0 + delta (two_sum: exact). Nothing in the step needs analysing: the bound is
+/// a posteriori, from the residual of x itself. With the exact (scaled) planes n*_i, d*_i,
+/// x* = J*^-1 d*, so x - x* = -J*^-1 r* for r*_i = d*_i - <n*_i, x>, and J*^-1 has columns
+/// bc*, ca*, ab* / W* (Cramer). Hence |x_k - x*_k| <= sum_i |cross*_i,k| |r*_i| / W*, where
+///  - |cross*_i,k| <= |cross_i,k| + 2^-50 of its double magnitude: n* is within eta = 2^-53 +
+///    2^-100 of |N| per component (lo and the plane's error), which moves the cross product
+///    by 2.01 eta of its magnitude, and its evaluation errs by 2 u of it; plus underflow;
+///  - W* >= w_low = W - 2^-48 MW - 2^-1000: W's evaluation errs by 5.01 u MW, the
+///    perturbation of N by 3.01 eta MW (8.1 u in all, taken as 32 u), products underflow by
+///    2^-1074 each; w_low > 0 is required (so W* > 0: pw = 1 is W times a positive factor);
+///  - |r*_i| <= |t_i| + E_i, t_i = (p_i - <N_i, delta>) + q_i in doubles, s_i = p_i + q_i
+///    (residual): p_i and the terms summed in q_i are exact but for the products of the
+///    normal's lo (each within u^2 |N| |x0|), and those ten terms total at most 6.01 u M_i
+///    (M_i = |d_i| + <|N_i|, |x0|>: each q, lo or two_prod rest is within u of a partial
+///    sum, a product or d), so q_i errs by 56 u^2 M_i; then t_i by 2.01 u |s_i| + 6.02 u D_i
+///    + 13 u^2 M_i more (D_i = <|N_i|, |delta|>; the normal's lo times delta is within u D_i;
+///    |s_i| <= |p_i| + 7 u M_i), 8 u (|p_i| + D_i) + 128 u^2 M_i in all; the planes err by
+///    2^-100 (M_i + D_i) (|x| <= |x0| + |delta|); underflow stays below 2^-950. E_i =
+///    8 u (|p_i| + D_i) + (128 u^2 + 2^-100) (M_i + D_i) + 2^-950.
+/// The factor 1.01 covers the rounding of the bound's own evaluation (and of 1 / w_low).
+/// The ranges: |N| < 2 and |d| <= 2^400 (valid planes), |x0| <= 2^400 checked, so no
+/// product overflows or loses its split; x's components are zero or in [2^-900, 2^400], as
+/// precise_scaled's, for the tests that read px.
+[[gnu::flatten]] bool newton_meet(const PrecisePlane& a, const PrecisePlane& b,
+                                  const PrecisePlane& c, HVertex& v) {
+  const V3<double> Na{a.c[0].hi, a.c[1].hi, a.c[2].hi}, Nb{b.c[0].hi, b.c[1].hi, b.c[2].hi},
+      Nc{c.c[0].hi, c.c[1].hi, c.c[2].hi};
+  const V3<double> bc = cross(Nb, Nc), ca = cross(Nc, Na), ab = cross(Na, Nb);
+  const double W = dot(Na, bc);
+  const auto absolute = [](const V3<double>& p) {
+    return V3<double>{std::abs(p.x), std::abs(p.y), std::abs(p.z)};
+  };
+  const V3<double> Ma = absolute(Na), Mb = absolute(Nb), Mc = absolute(Nc);
+  const V3<double> mbc = magnitude_cross(Mb, Mc), mca = magnitude_cross(Mc, Ma),
+                   mab = magnitude_cross(Ma, Mb);
+  const double w_low = W - 0x1p-48 * dot(Ma, mbc) - 0x1p-1000;
+  if (!(w_low > 0)) return false;
+  const double inverse = 1 / W;
+  const double da = a.c[3].hi, db = b.c[3].hi, dc = c.c[3].hi;
+  const V3<double> x0{(da * bc.x + db * ca.x + dc * ab.x) * inverse,
+                      (da * bc.y + db * ca.y + dc * ab.y) * inverse,
+                      (da * bc.z + db * ca.z + dc * ab.z) * inverse};
+  if (!(std::abs(x0.x) <= 0x1p400 && std::abs(x0.y) <= 0x1p400 && std::abs(x0.z) <= 0x1p400))
+    return false;
+  // s = p + q unevaluated (Ogita, Rump and Oishi's Dot2): two_prod and two_sum exact, the
+  // rest of them summed in q.
+  const auto residual = [&](const PrecisePlane& p) {
+    const DD h0 = two_prod(p.c[0].hi, x0.x), h1 = two_prod(p.c[1].hi, x0.y),
+             h2 = two_prod(p.c[2].hi, x0.z);
+    const DD s0 = two_sum(p.c[3].hi, -h0.hi), s1 = two_sum(s0.hi, -h1.hi),
+             s2 = two_sum(s1.hi, -h2.hi);
+    const double rest = (p.c[0].lo * x0.x + p.c[1].lo * x0.y) + p.c[2].lo * x0.z;
+    const double q = (p.c[3].lo + ((s0.lo + s1.lo) + s2.lo)) - (((h0.lo + h1.lo) + h2.lo) + rest);
+    return DD{s2.hi, q};
+  };
+  const DD sa = residual(a), sb = residual(b), sc = residual(c);
+  const double ta = sa.hi + sa.lo, tb = sb.hi + sb.lo, tc = sc.hi + sc.lo;
+  const V3<double> delta{(ta * bc.x + tb * ca.x + tc * ab.x) * inverse,
+                         (ta * bc.y + tb * ca.y + tc * ab.y) * inverse,
+                         (ta * bc.z + tb * ca.z + tc * ab.z) * inverse};
+  const V3<DD> x{two_sum(x0.x, delta.x), two_sum(x0.y, delta.y), two_sum(x0.z, delta.z)};
+  const auto in_range = [](double h) {
+    return h == 0 || (std::abs(h) >= 0x1p-900 && std::abs(h) <= 0x1p400);
+  };
+  if (!(in_range(x.x.hi) && in_range(x.y.hi) && in_range(x.z.hi))) return false;
+  const V3<double> ax0 = absolute(x0), adelta = absolute(delta);
+  const auto bound = [&](const V3<double>& N, const V3<double>& M, double d, const DD& s) {
+    const double D = dot(M, adelta), m = std::abs(d) + dot(M, ax0);
+    const double t = (s.hi - dot(N, delta)) + s.lo;
+    return std::abs(t) + 8 * 0x1p-53 * (std::abs(s.hi) + D) + (128 * kU2 + kPlaneRelative) * (m + D) +
+           0x1p-950;
+  };
+  const double ra = bound(Na, Ma, da, sa), rb = bound(Nb, Mb, db, sb), rc = bound(Nc, Mc, dc, sc);
+  // |cross*| <= |cross| + 2^-50 of its magnitude (below).
+  const auto adj = [](const V3<double>& p, const V3<double>& m) {
+    return V3<double>{std::abs(p.x) + 0x1p-50 * m.x, std::abs(p.y) + 0x1p-50 * m.y,
+                      std::abs(p.z) + 0x1p-50 * m.z};
+  };
+  const V3<double> Abc = adj(bc, mbc), Aca = adj(ca, mca), Aab = adj(ab, mab);
+  const double scale = 1.01 / w_low, under = 0x1p-1000 * (ra + rb + rc);
+  const V3<double> ex{(Abc.x * ra + Aca.x * rb + Aab.x * rc + under) * scale,
+                      (Abc.y * ra + Aca.y * rb + Aab.y * rc + under) * scale,
+                      (Abc.z * ra + Aca.z * rb + Aab.z * rc + under) * scale};
+  // Else precise_meet, whose bound is not worse (ill-conditioned triples).
+  const double largest = std::max({std::abs(x.x.hi), std::abs(x.y.hi), std::abs(x.z.hi)});
+  if (!(std::max({ex.x, ex.y, ex.z}) <= kNewtonAccepted * largest)) return false;
+  v.px = x;
+  v.pw = {1, 0};
+  v.ex = ex;
+  v.ew = 0;
+  v.precise = true;
+  return true;
+}
+
 /// One-time initialisations by index: call(i, f) runs f once for each i, in whichever thread
 /// asks first, the others waiting for it (run_once's atomic claim, halfspace_intersection.h).
 class OnceFlags {
@@ -763,7 +865,7 @@ void make_precise(const PrecisePlanes& planes, HVertex& v) {
   }
   const PrecisePlane &a = planes[v.planes[0]], &b = planes[v.planes[1]], &c = planes[v.planes[2]];
   if (!a.valid() || !b.valid() || !c.valid()) return;
-  precise_meet(a, b, c, v);
+  if (!newton_meet(a, b, c, v)) precise_meet(a, b, c, v);
 }
 
 /// Sign of <n, X> - d W from the precise stage, or 2 (round-to-nearest; both precise).
@@ -965,6 +1067,16 @@ double step_away(double r, bool away) {
 /// showed in the rounding loop's profile.
 [[gnu::flatten]] bool round_precise(const DD& X, double ex, const DD& W, double ew, double inverse,
                                     double& out) {
+  if (W.hi == 1 && W.lo == 0 && ew == 0) {  // (newton_meet's) X itself, within ex
+    // X.hi rounds X when X.lo +- ex stays strictly inside the half gaps to its neighbours
+    // (powers of two: rounding is monotone, so the rounded sums compare as the exact ones).
+    const double r = X.hi;
+    if (!(std::abs(r) >= 0x1p-500 && std::abs(r) <= 0x1p500)) return false;
+    const double up = step_away(r, r > 0) - r, down = r - step_away(r, r < 0);
+    if (!(X.lo + ex < 0.5 * up && X.lo - ex > -0.5 * down)) return false;
+    out = r;
+    return true;
+  }
   if (!(W.hi >= 0x1p-300 && W.hi <= 0x1p300) || !(ew <= 0x1p-60 * W.hi)) return false;
   // The residual R = X - r W in double-double: the product r W.hi is exact (Dekker), and
   // so is the cancelling X.hi - p.hi; what remains is small. `sum` bounds those small
@@ -2642,6 +2754,7 @@ PreciseProbe probe_precise(const std::vector<HalfSpace>& hs) {
   u.planes = {0, 1, 2};
   make_precise(precise, u);
   probe_rounding(u, out);
+  out.newton = u.precise && u.ew == 0;
   if (precise[0].valid() && precise[1].valid() && precise[2].valid())
     out.det = precise_det_sign(precise[0], precise[1], precise[2]);
   if (hs.size() < 4 || !u.precise || !precise[3].valid()) return out;

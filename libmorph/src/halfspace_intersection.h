@@ -300,6 +300,7 @@ struct PreciseProbe {
   int side = 2;     // of <n, u> - d for hs[3]
   int compare = 2;  // of <n, u> - <n, v> for hs[3]'s normal n
   int det = 2;      // of det(n_0, n_1, n_2)
+  bool newton = false;  // u's precise coordinates are X / W itself (newton_meet)
 };
 /// u is the meet of the planes of hs[0], hs[1] and hs[2] (det of their normals > 0 for all
 /// but `det`); v, when hs has 7 half-spaces, that of hs[4], hs[5] and hs[6].
