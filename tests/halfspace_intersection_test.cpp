@@ -544,6 +544,18 @@ TEST_CASE("halfspace_intersection: a closing from the sum's facets, without the 
     const ErosionInput want = erode_sum_input(S, A, B);
     const std::optional<ErosionInput> got = closing_input(sum, A, B);
     if (c.direct >= 0) CHECK(got.has_value() == (c.direct == 1));
+    if (got && c.name.starts_with("icosphere_320 by a")) {
+      // Its triangles' planes are fixed-point, left lazy (made from their words when read,
+      // by input_difference below): none made yet.
+      int lazy = 0;
+      for (const HalfSpace& h : got->halfspaces) {
+        if (!h.lazy) continue;
+        ++lazy;
+        CHECK(!h.has_exact_values());
+        CHECK((h.has_normal_dd && h.has_offset_dd));
+      }
+      CHECK(lazy > 0);
+    }
     if (got) CHECK(input_difference(*got, want) == "");
     const MaybePolytope via_sum = erode_sum(sum, A, B), via_s = erode_sum(S, A, B);
     CHECK(difference(via_sum, via_s) == "");
