@@ -456,8 +456,10 @@ std::string input_difference(const ErosionInput& got, const ErosionInput& want) 
   const auto same3 = [](const V3<ExactN>& a, const V3<ExactN>& b) {
     return a.x == b.x && a.y == b.y && a.z == b.z;
   };
+  // got's enclosure within want's (the closing encloses A's own vertices by their doubles,
+  // tighter than Mpzf::to_interval may be), and around the exact value (checked below).
   const auto same_interval = [](const Interval& a, const Interval& b) {
-    return a.inf() == b.inf() && a.sup() == b.sup();
+    return a.inf() >= b.inf() && a.sup() <= b.sup();
   };
   if (got.halfspaces.size() != want.halfspaces.size()) return "half-space counts differ";
   for (std::size_t k = 0; k < got.halfspaces.size(); ++k) {
@@ -476,6 +478,12 @@ std::string input_difference(const ErosionInput& got, const ErosionInput& want) 
   if (p.X.size() != q.X.size()) return "known point counts differ";
   for (std::size_t k = 0; k < p.X.size(); ++k) {
     if (!same3(p.X[k], q.X[k]) || p.W[k] != q.W[k]) return "known point " + std::to_string(k);
+    const auto encloses = [](const Interval& i, const ExactN& x) {
+      return Exact(i.inf()) <= Exact(x) && Exact(x) <= Exact(i.sup());
+    };
+    if (!encloses(p.Xi[k].x, p.X[k].x) || !encloses(p.Xi[k].y, p.X[k].y) ||
+        !encloses(p.Xi[k].z, p.X[k].z) || !encloses(p.Wi[k], p.W[k]))
+      return "known point " + std::to_string(k) + " outside its enclosure";
     if (!same_interval(p.Xi[k].x, q.Xi[k].x) || !same_interval(p.Xi[k].y, q.Xi[k].y) ||
         !same_interval(p.Xi[k].z, q.Xi[k].z) || !same_interval(p.Wi[k], q.Wi[k]))
       return "enclosure of known point " + std::to_string(k);

@@ -647,13 +647,18 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
   const std::vector<char> on_plane(corner_vertex.size(), 1);
   const auto pair_of = [&](int v) { return pairs[v]; };
   const auto point_of = [&](int v, int b, KnownPoints& known, int k) {
-    // (a_i + b_j) - b: a_i when b is j.
+    // (a_i + b_j) - b: a_i when b is j (most points: A's vertices), whose enclosure is the
+    // double itself, as to_interval_n gives it (no conversion back from Mpzf).
     const int i = pair_first(pairs[v]), j = pair_second(pairs[v]);
-    const V3<ExactN> a = to_exact_n(A.points[i]);
-    known.X[k] = j == b ? a : a + (to_exact_n(B.points[j]) - to_exact_n(B.points[b]));
     known.W[k] = ExactN(1);
+    known.Wi[k] = Interval(1);
+    if (j == b) {
+      known.X[k] = to_exact_n(A.points[i]);
+      known.Xi[k] = to_interval(A.points[i]);
+      return;
+    }
+    known.X[k] = to_exact_n(A.points[i]) + (to_exact_n(B.points[j]) - to_exact_n(B.points[b]));
     known.Xi[k] = to_interval_n(known.X[k]);
-    known.Wi[k] = to_interval_n(known.W[k]);
   };
   ErosionInput in;
   in.known = known_points(
