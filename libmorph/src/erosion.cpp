@@ -467,6 +467,16 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
   std::vector<std::span<const int>> others(nf);
   std::vector<int> one(nf);
   std::atomic<bool> general{!doubles};
+  // Each vertex's span (wide_exact.h) for the fixed-point frames below, found once rather
+  // than in each of its facets' frames (A's, B's and S's: a dozen or more).
+  std::vector<fixed::Span> spans_a(doubles ? A.num_vertices() : 0),
+      spans_b(doubles ? B.num_vertices() : 0);
+  parallel_chunks(static_cast<int>(spans_a.size()), 1024, [&](int begin, int end) {
+    for (int v = begin; v < end; ++v) spans_a[v].add(A.points[v]);
+  });
+  parallel_chunks(static_cast<int>(spans_b.size()), 1024, [&](int begin, int end) {
+    for (int v = begin; v < end; ++v) spans_b[v].add(B.points[v]);
+  });
   // Each facet of S is usually translated (one vertex of B: A's facet, in A's order), a
   // corner (one vertex of A: a facet of B) or a parallelogram (an edge of each). A's and B's
   // facets must be exactly planar (each is checked where it lies in S: A's facet g in S's
@@ -503,10 +513,11 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
       // set_fixed: in a small frame, with both double-double copies made, the exact values
       // are left lazy (most are never read; making them and their enclosures was a third of
       // the closing's input); otherwise made Mpzf now. The same values either way.
+      // `span`: that of x0, x1, y0 and y1 (a's is added here).
       const auto fixed_plane = [&](const V3<double>& x0, const V3<double>& x1, const V3<double>& y0,
-                                   const V3<double>& y1, int doubling) {
-        const fixed::Frame frame{x0.x, x0.y, x0.z, x1.x, x1.y, x1.z, y0.x, y0.y,
-                                 y0.z, y1.x, y1.y, y1.z, a.x,  a.y,  a.z};
+                                   const V3<double>& y1, int doubling, fixed::Span span) {
+        span.add(spans_a[i_at(0)]);
+        const fixed::Frame frame(span);
         if (!frame.ok) return false;
         const fixed::Normal n(frame, x0, x1, y0, y1);
         offset_set = true;
@@ -534,7 +545,12 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
       const auto planar = [&](const Polytope& P, int f) {
         if (P.degree(f) == 3) {
           const V3<double>& p = P.points[P.corner(f, 0)];
-          if (fixed_plane(p, P.points[P.corner(f, 1)], p, P.points[P.corner(f, 2)], 0)) return true;
+          const std::vector<fixed::Span>& spans = &P == &A ? spans_a : spans_b;
+          fixed::Span span = spans[P.corner(f, 0)];
+          span.add(spans[P.corner(f, 1)]);
+          span.add(spans[P.corner(f, 2)]);
+          if (fixed_plane(p, P.points[P.corner(f, 1)], p, P.points[P.corner(f, 2)], 0, span))
+            return true;
         }
         return planar_normal(P, f, &h.normal());
       };
@@ -556,6 +572,7 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
         // normal is twice (P1 - P0) x (P2 - P1).
         bool parallelogram = true;
         const V3<double>* side[2][2];  // side k runs from side[k][0] to side[k][1]
+        fixed::Span span;              // theirs
         for (int k = 0; k < 4 && parallelogram; ++k) {
           const int l = (k + 1) % 4;
           const bool moves_a = i_at(k) != i_at(l), moves_b = j_at(k) != j_at(l);
@@ -564,12 +581,14 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
           if (parallelogram && k < 2) {
             side[k][0] = moves_a ? &A.points[i_at(k)] : &B.points[j_at(k)];
             side[k][1] = moves_a ? &A.points[i_at(l)] : &B.points[j_at(l)];
+            span.add(moves_a ? spans_a[i_at(k)] : spans_b[j_at(k)]);
+            span.add(moves_a ? spans_a[i_at(l)] : spans_b[j_at(l)]);
           }
         }
         const int e = parallelogram ? B.edge_between(j_at(0), j_at(2)) : -1;
         if (e >= 0) {
           simple = true;
-          if (!fixed_plane(*side[0][0], *side[0][1], *side[1][0], *side[1][1], 1)) {
+          if (!fixed_plane(*side[0][0], *side[0][1], *side[1][0], *side[1][1], 1, span)) {
             const V3<ExactN> m = cross(exact_difference(*side[0][1], *side[0][0]),
                                        exact_difference(*side[1][1], *side[1][0]));
             h.normal() = {m.x + m.x, m.y + m.y, m.z + m.z};
