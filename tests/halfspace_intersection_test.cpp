@@ -456,8 +456,10 @@ std::string input_difference(const ErosionInput& got, const ErosionInput& want) 
   const auto same3 = [](const V3<ExactN>& a, const V3<ExactN>& b) {
     return a.x == b.x && a.y == b.y && a.z == b.z;
   };
+  // got's enclosure within want's (the closing encloses A's own vertices by their doubles,
+  // tighter than Mpzf::to_interval may be), and around the exact value (checked below).
   const auto same_interval = [](const Interval& a, const Interval& b) {
-    return a.inf() == b.inf() && a.sup() == b.sup();
+    return a.inf() >= b.inf() && a.sup() <= b.sup();
   };
   if (got.halfspaces.size() != want.halfspaces.size()) return "half-space counts differ";
   for (std::size_t k = 0; k < got.halfspaces.size(); ++k) {
@@ -476,6 +478,12 @@ std::string input_difference(const ErosionInput& got, const ErosionInput& want) 
   if (p.X.size() != q.X.size()) return "known point counts differ";
   for (std::size_t k = 0; k < p.X.size(); ++k) {
     if (!same3(p.X[k], q.X[k]) || p.W[k] != q.W[k]) return "known point " + std::to_string(k);
+    const auto encloses = [](const Interval& i, const ExactN& x) {
+      return Exact(i.inf()) <= Exact(x) && Exact(x) <= Exact(i.sup());
+    };
+    if (!encloses(p.Xi[k].x, p.X[k].x) || !encloses(p.Xi[k].y, p.X[k].y) ||
+        !encloses(p.Xi[k].z, p.X[k].z) || !encloses(p.Wi[k], p.W[k]))
+      return "known point " + std::to_string(k) + " outside its enclosure";
     if (!same_interval(p.Xi[k].x, q.Xi[k].x) || !same_interval(p.Xi[k].y, q.Xi[k].y) ||
         !same_interval(p.Xi[k].z, q.Xi[k].z) || !same_interval(p.Wi[k], q.Wi[k]))
       return "enclosure of known point " + std::to_string(k);
@@ -544,6 +552,18 @@ TEST_CASE("halfspace_intersection: a closing from the sum's facets, without the 
     const ErosionInput want = erode_sum_input(S, A, B);
     const std::optional<ErosionInput> got = closing_input(sum, A, B);
     if (c.direct >= 0) CHECK(got.has_value() == (c.direct == 1));
+    if (got && c.name.starts_with("icosphere_320 by a")) {
+      // Its triangles' planes are fixed-point, left lazy (made from their words when read,
+      // by input_difference below): none made yet.
+      int lazy = 0;
+      for (const HalfSpace& h : got->halfspaces) {
+        if (!h.lazy) continue;
+        ++lazy;
+        CHECK(!h.has_exact_values());
+        CHECK((h.has_normal_dd && h.has_offset_dd));
+      }
+      CHECK(lazy > 0);
+    }
     if (got) CHECK(input_difference(*got, want) == "");
     const MaybePolytope via_sum = erode_sum(sum, A, B), via_s = erode_sum(S, A, B);
     CHECK(difference(via_sum, via_s) == "");

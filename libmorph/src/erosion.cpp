@@ -8,6 +8,7 @@
 #include <memory>
 #include <numeric>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "fims.h"
@@ -78,13 +79,13 @@ struct Cycles {
 };
 
 /// erosion_points on facet cycles: `pair_of(v)` is vertex v's pair (X's vertex, B's vertex)
-/// when the eroded polytope is a sum X (+) B (`sum`; nx bounds X's vertices), and
-/// `point_of(v, b, known, k)` sets known point k to the exact v - b (under a RoundingGuard).
-template <class PairOf, class PointOf>
+/// when the eroded polytope is a sum X (+) B (`sum`; nx bounds X's vertices),
+/// `point_of(v, b, known, k)` sets known point k to the exact v - b (under a RoundingGuard),
+/// and `others_of(f)` is the span of facet f's further vertices of B attaining h_B.
+template <class PairOf, class PointOf, class OthersOf>
 KnownPoints known_points(const Cycles& A, bool sum, int nx, const PairOf& pair_of,
                          const PointOf& point_of, const std::vector<int>& contributing,
-                         const std::vector<std::vector<int>>& others,
-                         const std::vector<char>& on_plane) {
+                         const OthersOf& others_of, const std::vector<char>& on_plane) {
   KnownPoints known;
   const int nf = A.num_faces(), nv = A.num_vertices;
   // Lists of (b, point) per vertex of A and, for a sum, per vertex of X.
@@ -100,8 +101,9 @@ KnownPoints known_points(const Cycles& A, bool sum, int nx, const PairOf& pair_o
       if (!on_plane[c]) continue;
       const int v = A.corner_vertex[c];
       const std::uint64_t pair = sum ? pair_of(v) : 0;
-      for (int i = -1; i < static_cast<int>(others[f].size()); ++i) {
-        const int b = i < 0 ? contributing[f] : others[f][i];
+      const std::span<const int> others = others_of(f);
+      for (int i = -1; i < static_cast<int>(others.size()); ++i) {
+        const int b = i < 0 ? contributing[f] : others[i];
         const bool own = sum && pair_second(pair) == b;
         int& first = own ? head_x[pair_first(pair)] : head[v];
         int point = -1;
@@ -179,8 +181,9 @@ KnownPoints erosion_points(const Polytope& A, const Polytope& B,
       known.Wi[k] = to_interval_n(known.W[k]);
     }
   };
+  const auto others_of = [&](int f) { return std::span<const int>(others[f]); };
   return known_points(Cycles{A.face_begin, A.corner_vertex, A.num_vertices()}, sum, nx, pair_of,
-                      point_of, contributing, others, on_plane);
+                      point_of, contributing, others_of, on_plane);
 }
 
 }  // namespace
@@ -459,8 +462,21 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
   const bool doubles = A.exact_points.empty() && B.exact_points.empty();
   std::vector<HalfSpace> hs(nf);
   std::vector<int> contributing(nf);
-  std::vector<std::vector<int>> others(nf);
+  // Facet g's further vertices of B attaining h_B: a span of B's corners (those of a facet
+  // after its first) or of one[g] (an edge's other end); no list per facet to allocate.
+  std::vector<std::span<const int>> others(nf);
+  std::vector<int> one(nf);
   std::atomic<bool> general{!doubles};
+  // Each vertex's span (wide_exact.h) for the fixed-point frames below, found once rather
+  // than in each of its facets' frames (A's, B's and S's: a dozen or more).
+  std::vector<fixed::Span> spans_a(doubles ? A.num_vertices() : 0),
+      spans_b(doubles ? B.num_vertices() : 0);
+  parallel_chunks(static_cast<int>(spans_a.size()), 1024, [&](int begin, int end) {
+    for (int v = begin; v < end; ++v) spans_a[v].add(A.points[v]);
+  });
+  parallel_chunks(static_cast<int>(spans_b.size()), 1024, [&](int begin, int end) {
+    for (int v = begin; v < end; ++v) spans_b[v].add(B.points[v]);
+  });
   // Each facet of S is usually translated (one vertex of B: A's facet, in A's order), a
   // corner (one vertex of A: a facet of B) or a parallelogram (an edge of each). A's and B's
   // facets must be exactly planar (each is checked where it lies in S: A's facet g in S's
@@ -478,22 +494,50 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
       }
       HalfSpace& h = hs[g];
       int b = -1;
+      // B's facet f's corners after its first; edge e's other end.
+      const auto facet_others = [&](int f) {
+        others[g] = {&B.corner_vertex[B.face_begin[f] + 1],
+                     static_cast<std::size_t>(B.degree(f) - 1)};
+      };
+      const auto edge_other = [&](int e) {
+        one[g] = B.edges[e].to;
+        others[g] = {&one[g], 1};
+      };
       bool found = false;   // h's normal is S's normal n (the faces along n exactly planar)
       bool simple = false;  // translated, corner or parallelogram: n from A's or B's facet
       // h's offset is <n, a> for a corner (a, b_j) of the facet (see below).
       const V3<double>& a = A.points[i_at(0)];
       bool offset_set = false;
       // h's normal 2^doubling (x1 - x0) x (y1 - y0) and offset in fixed point
-      // (wide_exact.h) when the doubles allow; false when they do not.
+      // (wide_exact.h) when the doubles allow; false when they do not. As the erosion's
+      // set_fixed: in a small frame, with both double-double copies made, the exact values
+      // are left lazy (most are never read; making them and their enclosures was a third of
+      // the closing's input); otherwise made Mpzf now. The same values either way.
+      // `span`: that of x0, x1, y0 and y1 (a's is added here).
       const auto fixed_plane = [&](const V3<double>& x0, const V3<double>& x1, const V3<double>& y0,
-                                   const V3<double>& y1, int doubling) {
-        const fixed::Frame frame{x0.x, x0.y, x0.z, x1.x, x1.y, x1.z, y0.x, y0.y,
-                                 y0.z, y1.x, y1.y, y1.z, a.x,  a.y,  a.z};
+                                   const V3<double>& y1, int doubling, fixed::Span span) {
+        span.add(spans_a[i_at(0)]);
+        const fixed::Frame frame(span);
         if (!frame.ok) return false;
         const fixed::Normal n(frame, x0, x1, y0, y1);
-        n.set_normal(doubling, h.normal());  // hs's are new: zero
-        n.set_dot(doubling, a, nullptr, h.offset());
         offset_set = true;
+        h.has_normal_dd = n.normal_dd(doubling, h.normal_dd);
+        ExactWords& w = h.words;
+        V3<fixed::i128> normal;
+        fixed::Int<3> offset;
+        // <n, a - 0> is small_words' <n, a>.
+        if (h.has_normal_dd && n.small_words(doubling, a, V3<double>{0, 0, 0}, normal, w.normal_exp,
+                                             offset, w.offset_exp)) {
+          RoundingGuard nearest(CGAL_FE_TONEAREST);
+          if (fixed::to_dd(offset, w.offset_exp, h.offset_dd)) {
+            w.n = {normal.x, normal.y, normal.z};
+            w.d = {offset.w[0], offset.w[1], offset.w[2]};
+            h.has_offset_dd = h.lazy = true;
+            return true;
+          }
+        }
+        n.set_normal(doubling, h.normal());  // hs's are new: zero
+        h.has_offset_dd = n.set_dot(doubling, a, nullptr, h.offset(), &h.offset_dd);
         return true;
       };
       // planar_normal into h's normal; a triangle's (its normal (q - p) x (r - p)) in fixed
@@ -501,7 +545,12 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
       const auto planar = [&](const Polytope& P, int f) {
         if (P.degree(f) == 3) {
           const V3<double>& p = P.points[P.corner(f, 0)];
-          if (fixed_plane(p, P.points[P.corner(f, 1)], p, P.points[P.corner(f, 2)], 0)) return true;
+          const std::vector<fixed::Span>& spans = &P == &A ? spans_a : spans_b;
+          fixed::Span span = spans[P.corner(f, 0)];
+          span.add(spans[P.corner(f, 1)]);
+          span.add(spans[P.corner(f, 2)]);
+          if (fixed_plane(p, P.points[P.corner(f, 1)], p, P.points[P.corner(f, 2)], 0, span))
+            return true;
         }
         return planar_normal(P, f, &h.normal());
       };
@@ -516,13 +565,14 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
           simple = true;
           found = planar(B, f);
           b = B.corner(f, 0);
-          for (int k = 1; k < d; ++k) others[g].push_back(B.corner(f, k));
+          facet_others(f);
         }
       } else if (d == 4) {
         // A parallelogram: each side moves one operand's vertex, alternately. Its Newell
         // normal is twice (P1 - P0) x (P2 - P1).
         bool parallelogram = true;
         const V3<double>* side[2][2];  // side k runs from side[k][0] to side[k][1]
+        fixed::Span span;              // theirs
         for (int k = 0; k < 4 && parallelogram; ++k) {
           const int l = (k + 1) % 4;
           const bool moves_a = i_at(k) != i_at(l), moves_b = j_at(k) != j_at(l);
@@ -531,19 +581,21 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
           if (parallelogram && k < 2) {
             side[k][0] = moves_a ? &A.points[i_at(k)] : &B.points[j_at(k)];
             side[k][1] = moves_a ? &A.points[i_at(l)] : &B.points[j_at(l)];
+            span.add(moves_a ? spans_a[i_at(k)] : spans_b[j_at(k)]);
+            span.add(moves_a ? spans_a[i_at(l)] : spans_b[j_at(l)]);
           }
         }
         const int e = parallelogram ? B.edge_between(j_at(0), j_at(2)) : -1;
         if (e >= 0) {
           simple = true;
-          if (!fixed_plane(*side[0][0], *side[0][1], *side[1][0], *side[1][1], 1)) {
+          if (!fixed_plane(*side[0][0], *side[0][1], *side[1][0], *side[1][1], 1, span)) {
             const V3<ExactN> m = cross(exact_difference(*side[0][1], *side[0][0]),
                                        exact_difference(*side[1][1], *side[1][0]));
             h.normal() = {m.x + m.x, m.y + m.y, m.z + m.z};
           }
           found = true;
           b = B.edges[e].from;
-          others[g].push_back(B.edges[e].to);
+          edge_other(e);
         }
       }
       if (!simple) {
@@ -567,7 +619,7 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
           known_face = known_face && e >= 0;
           if (e >= 0) {
             b = B.edges[e].from;
-            others[g].push_back(B.edges[e].to);
+            edge_other(e);
           }
         } else {
           int f = -1;
@@ -582,7 +634,7 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
           known_face = known_face && f >= 0 && planar_normal(B, f, nullptr);
           if (known_face) {
             b = B.corner(f, 0);
-            for (int k = 1; k < B.degree(f); ++k) others[g].push_back(B.corner(f, k));
+            facet_others(f);
           }
         }
         if (known_face) {
@@ -614,18 +666,23 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
   const std::vector<char> on_plane(corner_vertex.size(), 1);
   const auto pair_of = [&](int v) { return pairs[v]; };
   const auto point_of = [&](int v, int b, KnownPoints& known, int k) {
-    // (a_i + b_j) - b: a_i when b is j.
+    // (a_i + b_j) - b: a_i when b is j (most points: A's vertices), whose enclosure is the
+    // double itself, as to_interval_n gives it (no conversion back from Mpzf).
     const int i = pair_first(pairs[v]), j = pair_second(pairs[v]);
-    const V3<ExactN> a = to_exact_n(A.points[i]);
-    known.X[k] = j == b ? a : a + (to_exact_n(B.points[j]) - to_exact_n(B.points[b]));
     known.W[k] = ExactN(1);
+    known.Wi[k] = Interval(1);
+    if (j == b) {
+      known.X[k] = to_exact_n(A.points[i]);
+      known.Xi[k] = to_interval(A.points[i]);
+      return;
+    }
+    known.X[k] = to_exact_n(A.points[i]) + (to_exact_n(B.points[j]) - to_exact_n(B.points[b]));
     known.Xi[k] = to_interval_n(known.X[k]);
-    known.Wi[k] = to_interval_n(known.W[k]);
   };
   ErosionInput in;
-  in.known =
-      known_points(Cycles{sum.face_begin, corner_vertex, static_cast<int>(pairs.size())}, true,
-                   A.num_vertices(), pair_of, point_of, contributing, others, on_plane);
+  in.known = known_points(
+      Cycles{sum.face_begin, corner_vertex, static_cast<int>(pairs.size())}, true, A.num_vertices(),
+      pair_of, point_of, contributing, [&](int g) { return others[g]; }, on_plane);
   // A's vertices, each with S's facets of its facets around it (the same facets by index).
   in.expected.begin = A.fan_begin;
   in.expected.split = false;
