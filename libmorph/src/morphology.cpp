@@ -28,12 +28,16 @@ MorphResult from_sum(const Polytope& a, const Polytope& b) {
   return r;
 }
 
-/// The mesh of an erosion's result, each face labelled by origin_of(facet of `p`).
+/// The mesh of an erosion's result, each face labelled by origin_of(facet of `p`). `p`'s
+/// corners are moved into the mesh (origin_of reads only its labels).
 template <class OriginOf>
-MorphResult from_rounded(const detail::RoundedPolytope& p, const OriginOf& origin_of) {
-  MorphResult r;
+MorphResult from_rounded(detail::RoundedPolytope& p, const OriginOf& origin_of) {
   std::vector<int> source;
-  r.mesh = detail::clean_mesh(p.points, p.face_begin, p.corner_vertex, &source);
+  // The mesh made in place: assigned, it was copied (OpenMesh has no move assignment).
+  MorphResult r{.mesh = detail::clean_mesh(p.points, p.face_begin, std::move(p.corner_vertex),
+                                           &source),
+                .origins = {},
+                .message = {}};
   r.origins.reserve(source.size());
   for (int f : source)
     r.origins.push_back(f >= 0 ? origin_of(f) : FacetOrigin{FacetKind::translated, {}, {}});
@@ -62,7 +66,7 @@ MorphResult dilate(const Mesh& A, const Mesh& B, const MorphologyOptions& option
 MorphResult erode(const Mesh& A, const Mesh& B, const MorphologyOptions& options) {
   return detail::run_with_threads(options.threads, [&] {
     const Operands op = detail::make_operands(A, B);
-    const detail::MaybePolytope e = detail::erode_polytope(op.a, op.b, kFinal);
+    detail::MaybePolytope e = detail::erode_polytope(op.a, op.b, kFinal);
     if (e.reason != EmptyReason::none) return empty_result(e);
     return from_rounded(e.rounded, [&](int f) { return erosion_origin(e.rounded, f); });
   });
@@ -80,7 +84,7 @@ MorphResult close(const Mesh& A, const Mesh& B, const MorphologyOptions& options
   return detail::run_with_threads(options.threads, [&] {
     const Operands op = detail::make_operands(A, B);
     const detail::SumFacets sum = detail::fims_facets(op.a, op.b);
-    const detail::MaybePolytope e = detail::erode_sum(sum, op.a, op.b, kFinal);
+    detail::MaybePolytope e = detail::erode_sum(sum, op.a, op.b, kFinal);
     if (e.reason != EmptyReason::none) return empty_result(e);
     // Each facet lies on a facet of A (+) B (its half-space's source): labelled as that one.
     return from_rounded(e.rounded, [&](int f) { return sum.origins[e.rounded.face_source[f]]; });
