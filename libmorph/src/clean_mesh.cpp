@@ -355,6 +355,21 @@ FacetGeometry quad_geometry(const std::vector<V3<double>>& points, const Soup& s
   return finish_geometry(origin, sum, (plus_zero(q1) + q2) + q3, longest_squared, 4);
 }
 
+/// The geometry of two facets from their lanes (`geo[0]` and `geo[1]`): zeros, as
+/// finish_geometry leaves them, for a lane without area.
+void store_pair(Pair longest, Pair area, const V3<Pair>& normal, Pair offset, FacetGeometry* geo) {
+  for (int i = 0; i < 2; ++i) {
+    FacetGeometry& g = geo[i];
+    g = FacetGeometry{};  // zeros
+    g.longest_edge = longest[i];
+    g.twice_area = area[i];
+    if (g.twice_area > 0) {
+      g.normal = {normal.x[i], normal.y[i], normal.z[i]};
+      g.offset = offset[i];
+    }
+  }
+}
+
 /// triangle_geometry (Degree 3) or quad_geometry (4) of facets f and f + 1 at once, one in
 /// each lane: each lane's operations are those of the one-facet function (a lane of a
 /// packed operation is the scalar one, IEEE), in about half the instructions. A lane whose
@@ -422,17 +437,7 @@ std::array<bool, 2> geometry_pair(const std::vector<V3<double>>& points, const S
     centroid = {origin.x + centroid.x * quarter, origin.y + centroid.y * quarter,
                 origin.z + centroid.z * quarter};
   }
-  const Pair offset = dot(normal, centroid);
-  for (int i = 0; i < 2; ++i) {
-    FacetGeometry& g = geo[f + i];
-    g = FacetGeometry{};  // zeros
-    g.longest_edge = longest[i];
-    g.twice_area = area[i];
-    if (g.twice_area > 0) {
-      g.normal = {normal.x[i], normal.y[i], normal.z[i]};
-      g.offset = offset[i];
-    }
-  }
+  store_pair(longest, area, normal, dot(normal, centroid), geo + f);
   return apart;
 }
 
@@ -478,17 +483,7 @@ void geometry_pair_any(const std::vector<V3<double>>& points, const Soup& soup, 
   const V3<Pair> normal{sum.x / area, sum.y / area, sum.z / area};
   const Pair n{static_cast<double>(du), static_cast<double>(dw)};
   centroid = {origin.x + centroid.x / n, origin.y + centroid.y / n, origin.z + centroid.z / n};
-  const Pair offsets = dot(normal, centroid);
-  for (int i = 0; i < 2; ++i) {
-    FacetGeometry& g = geo[f + i];
-    g = FacetGeometry{};  // zeros
-    g.longest_edge = longest[i];
-    g.twice_area = area[i];
-    if (g.twice_area > 0) {
-      g.normal = {normal.x[i], normal.y[i], normal.z[i]};
-      g.offset = offsets[i];
-    }
-  }
+  store_pair(longest, area, normal, dot(normal, centroid), geo + f);
 }
 
 bool is_thin(const FacetGeometry& g, double limit) {

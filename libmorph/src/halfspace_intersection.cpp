@@ -1358,6 +1358,28 @@ std::array<int, 3> sorted_triple(const std::array<int, 3>& x) {
   return {std::min(lo, x[2]), std::min(hi, mid), std::max(hi, mid)};
 }
 
+/// Each row of `rows` sorted into out[3 t ..] (in parallel) when every row's three entries
+/// are distinct and `keeps(t, a, b, c)` holds for each; false otherwise (out then unusable).
+template <class Keeps>
+bool sorted_triples(const std::vector<std::array<int, 3>>& rows, std::vector<int>& out,
+                    const Keeps& keeps) {
+  const int n = static_cast<int>(rows.size());
+  out.resize(3 * static_cast<std::size_t>(n));
+  std::atomic<bool> distinct = true;
+  parallel_chunks(n, 2048, [&](int begin, int end) {
+    bool here = true;
+    for (int t = begin; t < end; ++t) {
+      const auto [a, b, c] = sorted_triple(rows[t]);
+      out[3 * t] = a;
+      out[3 * t + 1] = b;
+      out[3 * t + 2] = c;
+      here &= (a < b) & (b < c) & keeps(t, a, b, c);
+    }
+    if (!here) distinct = false;
+  });
+  return distinct;
+}
+
 /// Sorts each list list[begin[i] .. begin[i + 1]) and drops repeats in it, compacting (the
 /// lists are short: three elements by sorted_triple, as most are, others by insertion).
 void sort_unique_lists(std::vector<int>& begin, std::vector<int>& list) {
@@ -2019,20 +2041,9 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   std::vector<int> adj_begin(nv + 1, 0), adj;
   bool adj_made = false;
   if (simple) {
-    adj.resize(3 * static_cast<std::size_t>(nt));
-    std::atomic<bool> distinct = true;
-    parallel_chunks(nt, 2048, [&](int begin, int end) {
-      bool here = true;
-      for (int t = begin; t < end; ++t) {
-        const auto [a, b, c] = sorted_triple(s.across[t]);
-        adj[3 * t] = a;
-        adj[3 * t + 1] = b;
-        adj[3 * t + 2] = c;
-        here &= (a < b) & (b < c) & (a != t) & (b != t) & (c != t);
-      }
-      if (!here) distinct = false;
-    });
-    if (distinct) {
+    if (sorted_triples(s.across, adj, [](int t, int a, int b, int c) {
+          return (a != t) & (b != t) & (c != t);
+        })) {
       for (int v = 0; v <= nv; ++v) adj_begin[v] = 3 * v;
       adj_made = true;
     }
@@ -2203,20 +2214,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   bool key_made = false;
   if (simple && std::all_of(touched.begin(), touched.end(),
                             [](const std::vector<int>& plateau) { return plateau.empty(); })) {
-    key.resize(3 * static_cast<std::size_t>(nt));
-    std::atomic<bool> distinct = true;
-    parallel_chunks(nt, 2048, [&](int begin, int end) {
-      bool here = true;
-      for (int t = begin; t < end; ++t) {
-        const auto [a, b, c] = sorted_triple(s.corner[t]);
-        key[3 * t] = a;
-        key[3 * t + 1] = b;
-        key[3 * t + 2] = c;
-        here &= (a < b) & (b < c);
-      }
-      if (!here) distinct = false;
-    });
-    if (distinct) {
+    if (sorted_triples(s.corner, key, [](int, int, int, int) { return true; })) {
       for (int v = 0; v <= nv; ++v) key_begin[v] = 3 * v;
       key_made = true;
     }
