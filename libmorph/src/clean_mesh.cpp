@@ -355,6 +355,14 @@ FacetGeometry quad_geometry(const std::vector<V3<double>>& points, const Soup& s
   return finish_geometry(origin, sum, (plus_zero(q1) + q2) + q3, longest_squared, 4);
 }
 
+/// Any facet's geometry by the function for its degree (the same values as `geometry`'s).
+FacetGeometry facet_geometry(const std::vector<V3<double>>& points, const Soup& soup, int f) {
+  const int d = soup.degree(f);
+  return d == 3   ? triangle_geometry(points, soup, f)
+         : d == 4 ? quad_geometry(points, soup, f)
+                  : geometry(points, soup, f);
+}
+
 /// The geometry of two facets from their lanes (`geo[0]` and `geo[1]`): zeros, as
 /// finish_geometry leaves them, for a lane without area.
 void store_pair(Pair longest, Pair area, const V3<Pair>& normal, Pair offset, FacetGeometry* geo) {
@@ -972,9 +980,7 @@ void geometries(const std::vector<V3<double>>& points, const Soup& soup, FacetGe
         ++f;
         continue;
       }
-      geo[f] = d == 3   ? triangle_geometry(points, soup, f)
-               : d == 4 ? quad_geometry(points, soup, f)
-                        : geometry(points, soup, f);
+      geo[f] = facet_geometry(points, soup, f);
     }
   });
 }
@@ -1516,7 +1522,7 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
     parallel_chunks(nf, kFacetGrain, [&](int first, int last) {
       bool found = false, irregular = false;
       std::vector<std::pair<int, int>> pairs;  // this chunk's close pairs
-      bool here = false;  // whether the facet tested last has close corners
+      bool here = false;                       // whether the facet tested last has close corners
       const auto check = [&](int u, int w) {
         if (u == w || close(u, w)) {
           here = true;
@@ -1564,9 +1570,7 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
           continue;
         }
         if (d >= 3)  // (a facet of fewer corners is not the soup's)
-          geo[f] = d == 3   ? triangle_geometry(points, soup, f)
-                   : d == 4 ? quad_geometry(points, soup, f)
-                            : geometry(points, soup, f);
+          geo[f] = facet_geometry(points, soup, f);
         test(f, surely_apart(f));
         irregular = irregular || d < 3 || d > kPairwiseDegree;
       }
@@ -1618,7 +1622,7 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
     const std::unique_ptr<FacetGeometry[]> given_geo = std::move(pre.geo);
     pre = {};
     pre.geo = std::make_unique_for_overwrite<FacetGeometry[]>(nf);  // no more facets than given
-    if (!any_close) clusters = UnionFind(n);  // each point its own cluster
+    if (!any_close) clusters = UnionFind(n);                        // each point its own cluster
     Soup merged;
     std::vector<int> last_facet(n, -1);  // the last facet a point was seen in, to find repeats
     merged.vertex.reserve(corners.size());
@@ -1657,9 +1661,7 @@ Mesh clean_mesh(const std::vector<V3<double>>& points, const std::vector<int>& f
         ++i;
         continue;
       }
-      pre.geo[m] = d == 3   ? triangle_geometry(points, soup, m)
-                   : d == 4 ? quad_geometry(points, soup, m)
-                            : geometry(points, soup, m);
+      pre.geo[m] = facet_geometry(points, soup, m);
     }
   }
   std::optional<std::pair<Soup, Connectivity>> result;

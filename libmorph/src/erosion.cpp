@@ -197,6 +197,42 @@ void HalfSpace::set_exact_from_words(const HalfSpace& h) {
 
 namespace {
 
+/// Each vertex's span (wide_exact.h) for the fixed-point frames of its facets, found once
+/// rather than in each frame the vertex is in (about six for a triangulated A).
+std::vector<fixed::Span> vertex_spans(const Polytope& P) {
+  std::vector<fixed::Span> spans(P.num_vertices());
+  parallel_chunks(P.num_vertices(), 1024, [&](int begin, int end) {
+    for (int v = begin; v < end; ++v) spans[v].add(P.points[v]);
+  });
+  return spans;
+}
+
+/// Sets a new half-space h (exact values zero) to the fixed-point plane of normal n scaled
+/// by 2^doubling and offset <n, top - *sub> (<n, top> without sub). In a small frame, when
+/// both double-double copies are made, its exact values are left lazy (their words kept:
+/// most are never read, the filters and the precise stage taking the copies); otherwise
+/// they are made Mpzf now. The same values either way.
+void set_fixed_plane(HalfSpace& h, const fixed::Normal& n, int doubling, const V3<double>& top,
+                     const V3<double>* sub) {
+  h.has_normal_dd = n.normal_dd(doubling, h.normal_dd);
+  ExactWords& w = h.words;
+  V3<fixed::i128> normal;
+  fixed::Int<3> offset;
+  // (<n, top - 0> is small_words' <n, top>.)
+  if (h.has_normal_dd && n.small_words(doubling, top, sub ? *sub : V3<double>{0, 0, 0}, normal,
+                                       w.normal_exp, offset, w.offset_exp)) {
+    RoundingGuard nearest(CGAL_FE_TONEAREST);
+    if (fixed::to_dd(offset, w.offset_exp, h.offset_dd)) {
+      w.n = {normal.x, normal.y, normal.z};
+      w.d = {offset.w[0], offset.w[1], offset.w[2]};
+      h.has_offset_dd = h.lazy = true;
+      return;
+    }
+  }
+  n.set_normal(doubling, h.normal());
+  h.has_offset_dd = n.set_dot(doubling, top, sub, h.offset(), &h.offset_dd);
+}
+
 ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b,
                            ExpectedVertices expected) {
   const std::vector<Location> loc = locate_all(A, B);
@@ -205,15 +241,10 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
   std::vector<char> on_plane(A.corner_vertex.size(), 0);  // per corner of A
   std::vector<int> contributing(nf);                      // the vertex of B moving f
   std::vector<std::vector<int>> others(nf);               // more vertices of B attaining h_B(N_f)
-  // Each vertex's span (wide_exact.h) for the fixed-point frames below, found once rather
-  // than in each of its facets' frames (about six).
-  std::vector<fixed::Span> spans;
-  if (A.given_normals.empty() && B.exact_points.empty()) {
-    spans.resize(A.num_vertices());
-    parallel_chunks(A.num_vertices(), 1024, [&](int begin, int end) {
-      for (int v = begin; v < end; ++v) spans[v].add(A.points[v]);
-    });
-  }
+  // (For the fixed-point frames below.)
+  const std::vector<fixed::Span> spans = A.given_normals.empty() && B.exact_points.empty()
+                                             ? vertex_spans(A)
+                                             : std::vector<fixed::Span>();
   parallel_chunks(nf, 64, [&](int begin, int end) {
     std::vector<Homogeneous> dots;
     std::vector<int> candidates;
@@ -234,29 +265,9 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
               CGAL::sign(dot(h.exact_normal(), exact_difference(B.points[c], B.points[b]))) == 0)
             others[f].push_back(c);
       };
-      // A fixed-point plane (wide_exact.h) with the offset <n, top - pb>: in a small frame,
-      // when both double-double copies are made, its exact values are left lazy (their words
-      // kept: most are never read, the filters and the precise stage taking the copies);
-      // otherwise made Mpzf now. The same values either way.
+      // A fixed-point plane (wide_exact.h) with the offset <n, top - pb>.
       const auto set_fixed = [&](const fixed::Normal& n, const V3<double>& top,
-                                 const V3<double>& pb) {
-        h.has_normal_dd = n.normal_dd(0, h.normal_dd);
-        ExactWords& w = h.words;
-        V3<fixed::i128> normal;
-        fixed::Int<3> offset;
-        if (h.has_normal_dd &&
-            n.small_words(0, top, pb, normal, w.normal_exp, offset, w.offset_exp)) {
-          RoundingGuard nearest(CGAL_FE_TONEAREST);
-          if (fixed::to_dd(offset, w.offset_exp, h.offset_dd)) {
-            w.n = {normal.x, normal.y, normal.z};
-            w.d = {offset.w[0], offset.w[1], offset.w[2]};
-            h.has_offset_dd = h.lazy = true;
-            return;
-          }
-        }
-        n.set_normal(0, h.normal());  // hs's are new: zero
-        h.has_offset_dd = n.set_dot(0, top, &pb, h.offset(), &h.offset_dd);
-      };
+                                 const V3<double>& pb) { set_fixed_plane(h, n, 0, top, &pb); };
       if (A.degree(f) == 3 && A.given_normals.empty() && B.exact_points.empty()) {
         // A triangle of double points (A's are then all doubles) and an element of double
         // points: its Newell normal is (q - p) x (r - p), the same value in fewer products,
@@ -467,16 +478,9 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
   std::vector<std::span<const int>> others(nf);
   std::vector<int> one(nf);
   std::atomic<bool> general{!doubles};
-  // Each vertex's span (wide_exact.h) for the fixed-point frames below, found once rather
-  // than in each of its facets' frames (A's, B's and S's: a dozen or more).
-  std::vector<fixed::Span> spans_a(doubles ? A.num_vertices() : 0),
-      spans_b(doubles ? B.num_vertices() : 0);
-  parallel_chunks(static_cast<int>(spans_a.size()), 1024, [&](int begin, int end) {
-    for (int v = begin; v < end; ++v) spans_a[v].add(A.points[v]);
-  });
-  parallel_chunks(static_cast<int>(spans_b.size()), 1024, [&](int begin, int end) {
-    for (int v = begin; v < end; ++v) spans_b[v].add(B.points[v]);
-  });
+  // (For the fixed-point frames below: A's, B's and S's, a dozen or more per vertex.)
+  const std::vector<fixed::Span> spans_a = doubles ? vertex_spans(A) : std::vector<fixed::Span>(),
+                                 spans_b = doubles ? vertex_spans(B) : std::vector<fixed::Span>();
   // Each facet of S is usually translated (one vertex of B: A's facet, in A's order), a
   // corner (one vertex of A: a facet of B) or a parallelogram (an edge of each). A's and B's
   // facets must be exactly planar (each is checked where it lies in S: A's facet g in S's
@@ -508,12 +512,10 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
       // h's offset is <n, a> for a corner (a, b_j) of the facet (see below).
       const V3<double>& a = A.points[i_at(0)];
       bool offset_set = false;
-      // h's normal 2^doubling (x1 - x0) x (y1 - y0) and offset in fixed point
-      // (wide_exact.h) when the doubles allow; false when they do not. As the erosion's
-      // set_fixed: in a small frame, with both double-double copies made, the exact values
-      // are left lazy (most are never read; making them and their enclosures was a third of
-      // the closing's input); otherwise made Mpzf now. The same values either way.
-      // `span`: that of x0, x1, y0 and y1 (a's is added here).
+      // h's normal 2^doubling (x1 - x0) x (y1 - y0) and offset <n, a> in fixed point
+      // (wide_exact.h) when the doubles allow, lazy as the erosion's (set_fixed_plane: making
+      // the exact values and their enclosures was a third of the closing's input); false
+      // when they do not. `span`: that of x0, x1, y0 and y1 (a's is added here).
       const auto fixed_plane = [&](const V3<double>& x0, const V3<double>& x1, const V3<double>& y0,
                                    const V3<double>& y1, int doubling, fixed::Span span) {
         span.add(spans_a[i_at(0)]);
@@ -521,23 +523,7 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
         if (!frame.ok) return false;
         const fixed::Normal n(frame, x0, x1, y0, y1);
         offset_set = true;
-        h.has_normal_dd = n.normal_dd(doubling, h.normal_dd);
-        ExactWords& w = h.words;
-        V3<fixed::i128> normal;
-        fixed::Int<3> offset;
-        // <n, a - 0> is small_words' <n, a>.
-        if (h.has_normal_dd && n.small_words(doubling, a, V3<double>{0, 0, 0}, normal, w.normal_exp,
-                                             offset, w.offset_exp)) {
-          RoundingGuard nearest(CGAL_FE_TONEAREST);
-          if (fixed::to_dd(offset, w.offset_exp, h.offset_dd)) {
-            w.n = {normal.x, normal.y, normal.z};
-            w.d = {offset.w[0], offset.w[1], offset.w[2]};
-            h.has_offset_dd = h.lazy = true;
-            return true;
-          }
-        }
-        n.set_normal(doubling, h.normal());  // hs's are new: zero
-        h.has_offset_dd = n.set_dot(doubling, a, nullptr, h.offset(), &h.offset_dd);
+        set_fixed_plane(h, n, doubling, a, nullptr);
         return true;
       };
       // planar_normal into h's normal; a triangle's (its normal (q - p) x (r - p)) in fixed
@@ -641,7 +627,8 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
           std::vector<V3<ExactN>> cycle(d);
           for (int k = 0; k < d; ++k)
             cycle[k] = to_exact_n(A.points[i_at(k)]) + to_exact_n(B.points[j_at(k)]);
-          h.normal() = newell_normal<ExactN>(d, [&](int k) -> const V3<ExactN>& { return cycle[k]; });
+          h.normal() =
+              newell_normal<ExactN>(d, [&](int k) -> const V3<ExactN>& { return cycle[k]; });
           found = true;
         }
       }

@@ -201,7 +201,9 @@ std::vector<Plane> planes_of(const std::vector<HalfSpace>& hs) {
   return planes;
 }
 
-Exact rational_offset(const HalfSpace& h) { return Exact(h.exact_offset()) / Exact(h.denominator()); }
+Exact rational_offset(const HalfSpace& h) {
+  return Exact(h.exact_offset()) / Exact(h.denominator());
+}
 
 /// Chebyshev-like centre for the L1 norm: maximise t subject to
 /// <n_i, x> + |n_i|_1 t <= d_i, t <= 1. t* > 0: a solid (x* strictly inside);
@@ -317,6 +319,16 @@ struct DualSurface {
   // triangles it left, with the same neighbours.
   bool oriented = false;
   std::vector<signed char> far_side;
+
+  /// The far plane of triangle t's edge k: the corner of the triangle across it that is not
+  /// on the edge (-1: none, a degenerate neighbour).
+  int far_corner(int t, int k) const {
+    const int a = corner[t][k], b = corner[t][k == 2 ? 0 : k + 1];
+    int far = -1;
+    for (const int c : corner[across[t][k]])
+      if (c != a && c != b) far = c;
+    return far;
+  }
 };
 
 /// The triangles of a hull computed by CGAL; empty when it is not a closed triangulated
@@ -609,9 +621,9 @@ PrecisePlane precise_plane(const Plane& plane) {
   const HalfSpace* h = plane.source;
   // (A lazy half-space has both copies: its exact values are not read here.)
   if (h && !(h->has_normal_dd && h->has_offset_dd)) h->make_exact();
-  precise_scaled({&plane.n_exact->x, &plane.n_exact->y, &plane.n_exact->z, plane.d_exact},
-                           0, 3, p.c, h && h->has_normal_dd ? &h->normal_dd : nullptr,
-                           h && h->has_offset_dd ? &h->offset_dd : nullptr);
+  precise_scaled({&plane.n_exact->x, &plane.n_exact->y, &plane.n_exact->z, plane.d_exact}, 0, 3,
+                 p.c, h && h->has_normal_dd ? &h->normal_dd : nullptr,
+                 h && h->has_offset_dd ? &h->offset_dd : nullptr);
   return p;
 }
 V3<DD> normal_dd(const PrecisePlane& p) { return {p.c[0], p.c[1], p.c[2]}; }
@@ -725,8 +737,8 @@ V3<Magnitude> normal_magnitude(const PrecisePlane& p) { return magnitude(normal_
   const auto bound = [&](const V3<double>& N, const V3<double>& M, double d, const DD& s) {
     const double D = dot(M, adelta), m = std::abs(d) + dot(M, ax0);
     const double t = (s.hi - dot(N, delta)) + s.lo;
-    return std::abs(t) + 8 * 0x1p-53 * (std::abs(s.hi) + D) + (128 * kU2 + kPlaneRelative) * (m + D) +
-           0x1p-950;
+    return std::abs(t) + 8 * 0x1p-53 * (std::abs(s.hi) + D) +
+           (128 * kU2 + kPlaneRelative) * (m + D) + 0x1p-950;
   };
   const double ra = bound(Na, Ma, da, sa), rb = bound(Nb, Mb, db, sb), rc = bound(Nc, Mc, dc, sc);
   // |cross*| <= |cross| + 2^-50 of its magnitude (below).
@@ -1695,12 +1707,8 @@ bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& preci
       const int u = s.across[t][k];
       if (!changed[t] && !changed[u]) {
         far_side[3 * index[t] + k] = s.far_side[3 * t + k];
-      } else if (tested_far[3 * t + k] >= 0) {
-        const int a = s.corner[t][k], b = s.corner[t][next(k)];
-        int far = -1;
-        for (int c : s.corner[u])
-          if (c != a && c != b) far = c;
-        if (far == tested_far[3 * t + k]) far_side[3 * index[t] + k] = tested_sign[3 * t + k];
+      } else if (tested_far[3 * t + k] >= 0 && s.far_corner(t, k) == tested_far[3 * t + k]) {
+        far_side[3 * index[t] + k] = tested_sign[3 * t + k];
       }
     }
   }
@@ -1944,11 +1952,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       }
       for (int k = 0; k < 3; ++k) {
         if (far_side[3 * t + k] != 2) continue;
-        const auto& cn = s.corner[s.across[t][k]];
-        const int a = s.corner[t][k], b = s.corner[t][(k + 1) % 3];
-        int far = -1;
-        for (int j = 0; j < 3; ++j)
-          if (cn[j] != a && cn[j] != b) far = cn[j];
+        const int far = s.far_corner(t, k);
         const int sd = far < 0                        ? 1
                        : known_through(known, far, v) ? 0
                                                       : side(planes, precise, far, v);
@@ -2041,9 +2045,8 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   std::vector<int> adj_begin(nv + 1, 0), adj;
   bool adj_made = false;
   if (simple) {
-    if (sorted_triples(s.across, adj, [](int t, int a, int b, int c) {
-          return (a != t) & (b != t) & (c != t);
-        })) {
+    if (sorted_triples(s.across, adj,
+                       [](int t, int a, int b, int c) { return (a != t) & (b != t) & (c != t); })) {
       for (int v = 0; v <= nv; ++v) adj_begin[v] = 3 * v;
       adj_made = true;
     }
@@ -2892,8 +2895,7 @@ constexpr int kFlipsPerCorner = 4;
 /// Needs a RoundingGuard.
 bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& precise,
                          const KnownPoints& known, const V3<double>& o, const int* p, int k,
-                         bool split,
-                         std::array<int, 3>* out, HVertex* out_vertex, char* out_has,
+                         bool split, std::array<int, 3>* out, HVertex* out_vertex, char* out_has,
                          signed char* out_far, PolygonScratch& scratch) {
   // Planes through one known point (facets of A moved by one vertex of B): one vertex.
   if (k == 3 || common_point(known, p, k) >= 0) {
@@ -3232,8 +3234,7 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
     bool repaired = false;
     if (auto built = build_verified(hs, planes, precise, known,
                                     expected_surface(planes, precise, known, expected, o_double),
-                                    options,
-                                    owner, &repaired)) {
+                                    options, owner, &repaired)) {
       built->route = repaired ? HullRoute::repaired : HullRoute::expected;
       return std::move(*built);
     }
