@@ -153,6 +153,21 @@ void check_against(const MorphResult& r, const ExactSet& want, const Mesh& A, bo
   CHECK_MESSAGE(left.empty(), "the result has ", left);
 }
 
+// Facet f of A's unit Newell normal n and its support value h_A(n), the largest <n, p> over
+// its corners.
+std::pair<Point, double> facet_plane(const Mesh& A, int f) {
+  REQUIRE((f >= 0 && f < static_cast<int>(A.n_faces())));
+  Point n(0, 0, 0);
+  std::vector<Point> corners;
+  for (auto v : A.fv_range(A.face_handle(f))) corners.push_back(A.point(v));
+  for (std::size_t k = 0; k < corners.size(); ++k)
+    n += OpenMesh::cross(corners[k], corners[(k + 1) % corners.size()]);
+  n.normalize();
+  double h_a = -1e300;
+  for (const Point& p : corners) h_a = std::max(h_a, OpenMesh::dot(n, p));
+  return {n, h_a};
+}
+
 // The labels of an erosion: one per face, each a facet of A moved inwards by a vertex b of
 // B that supports B along its normal n, and the face lies on that plane:
 // <n, x> = h_A(n) - <n, b> (to within the planarity tolerance). A closing's faces are A's
@@ -167,16 +182,8 @@ void check_erosion_labels(const MorphResult& r, const Mesh& A, const Mesh& B,
     CAPTURE(f.idx());
     CHECK(o.kind == morph::FacetKind::translated);
     REQUIRE(o.a.kind == morph::Element::Kind::facet);
-    REQUIRE((o.a.index >= 0 && o.a.index < static_cast<int>(A.n_faces())));
-    const auto fa = A.face_handle(o.a.index);
-    Point n(0, 0, 0);
-    std::vector<Point> corners;
-    for (auto v : A.fv_range(fa)) corners.push_back(A.point(v));
-    for (std::size_t k = 0; k < corners.size(); ++k)
-      n += OpenMesh::cross(corners[k], corners[(k + 1) % corners.size()]);
-    n.normalize();
-    double h_a = -1e300, h_b = -1e300;
-    for (const Point& p : corners) h_a = std::max(h_a, OpenMesh::dot(n, p));
+    const auto [n, h_a] = facet_plane(A, o.a.index);
+    double h_b = -1e300;
     for (auto v : B.vertices()) h_b = std::max(h_b, OpenMesh::dot(n, B.point(v)));
     double plane = h_a;
     // A closing's label may name an edge or facet of B (parallel to A's facet) instead.
@@ -317,6 +324,63 @@ TEST_CASE("morph: closing a convex polytope gives it back") {
         CHECK(same_body(cc.mesh, c.mesh, kChainedTol).empty());
       }
     }
+  }
+}
+
+// UV spheres' quads are planar only within the tolerance. Their exact sum S with some
+// elements folds at a vertex (its canonical build threw not_convex: "A (+) B: the facets
+// around vertex 78 do not turn convexly") or merges facets across edges that are not strictly
+// convex, whose planes then cut A by up to 7% of its radius (UV sphere n = 29 closed by a
+// small UV sphere lost 0.07 of A's vertices' positions). These pairs took each path.
+TEST_CASE("morph: closing a UV sphere gives it back where its exact sum folds or merges") {
+  const struct {
+    int n;
+    const char* element;
+  } cases[] = {{5, "snub_dodecahedron:0.25"}, {10, "snub_dodecahedron:0.25"},
+               {7, "uvsphere:r=0.1,n=7"},     {42, "octahedron:0.1"},
+               {28, "tetrahedron:0.2"},       {28, "octahedron:0.1"},
+               {29, "uvsphere:r=0.1,n=7"},    {36, "tetrahedron:0.2"}};
+  for (const auto& c : cases) {
+    INFO("uvsphere n = ", c.n, " closed by ", c.element);
+    const Mesh A = make_uv_sphere(1.0, c.n);
+    const Mesh B = make_structuring_element(c.element);
+    const MorphResult closed = run_close(A, B);
+    REQUIRE_FALSE(closed.is_empty());
+    check_clean(closed);
+    // These closings erode the rounded sum, whose facets merged within the tolerance take
+    // the label of their largest member: a facet of A next to a pole can lie on a merged
+    // facet labelled as an edge facet (A's edge + B's edge). It lies on that edge facet's
+    // plane, within the tolerance; every other facet is a translated facet of A.
+    REQUIRE(closed.origins.size() == closed.mesh.n_faces());
+    const double tol = 2 * kPlanarityTolerance * bbox_diagonal(A);
+    for (auto f : closed.mesh.faces()) {
+      const morph::FacetOrigin& o = closed.origins[f.idx()];
+      CAPTURE(f.idx());
+      if (o.kind == FacetKind::translated) {
+        REQUIRE(o.a.kind == Element::Kind::facet);
+        const auto [n, h_a] = facet_plane(A, o.a.index);
+        for (auto v : closed.mesh.fv_range(f))
+          CHECK(std::abs(OpenMesh::dot(n, closed.mesh.point(v)) - h_a) <= tol);
+        continue;
+      }
+      REQUIRE(o.kind == FacetKind::edge);
+      REQUIRE(o.a.kind == Element::Kind::edge);
+      REQUIRE(o.b.kind == Element::Kind::edge);
+      const auto ends = [](const Mesh& m, int e) {
+        const auto h = m.halfedge_handle(m.edge_handle(e), 0);
+        return std::pair{m.point(m.from_vertex_handle(h)), m.point(m.to_vertex_handle(h))};
+      };
+      const auto [a0, a1] = ends(A, o.a.index);
+      const auto [b0, b1] = ends(B, o.b.index);
+      const Point n = OpenMesh::cross(a1 - a0, b1 - b0).normalized();
+      for (auto v : closed.mesh.fv_range(f))
+        CHECK(std::abs(OpenMesh::dot(n, closed.mesh.point(v) - a0)) <= tol);
+    }
+    const Description got = describe(closed.mesh), want = describe(A);
+    CHECK(got.facet_count == want.facet_count);
+    CHECK(got.facet_degrees() == want.facet_degrees());
+    const std::string diff = same_body(closed.mesh, A, kChainedTol);
+    CHECK_MESSAGE(diff.empty(), diff);
   }
 }
 

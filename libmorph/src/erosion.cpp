@@ -2,6 +2,8 @@
 // by B's support values, and the closing (A (+) B) (-) B, as inputs to the exact half-space
 // intersection (halfspace_intersection.cpp): the half-spaces, the points known to lie on
 // their planes (KnownPoints) and the expected result (ExpectedVertices).
+#include <morph/error.h>
+
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -461,10 +463,22 @@ bool same_cycle(const Polytope& P, int f, int d, const VertexAt& vertex_at) {
 
 }  // namespace
 
-MaybePolytope erode_sum(const SumFacets& sum, const Polytope& A, const Polytope& B,
-                        const IntersectOptions& options) {
-  if (std::optional<ErosionInput> in = closing_input(sum, A, B)) return intersect(*in, options);
-  return erode_sum(sum_polytope(A, B, sum), A, B, options);
+Closing close_polytope(const Polytope& A, const Polytope& B, const IntersectOptions& options) {
+  SumFacets sum = fims_facets(A, B);
+  if (std::optional<ErosionInput> in = closing_input(sum, A, B))
+    return {intersect(*in, options), std::move(sum.origins)};
+  // A facet of A or B is planar only within the tolerance (see the header).
+  std::optional<Polytope> S;
+  try {
+    S = sum_polytope(A, B, sum);
+  } catch (const not_convex&) {
+    // S's normals fold: the rounded route below.
+  }
+  if (S && S->num_faces() == sum.num_faces())
+    return {erode_sum(*S, A, B, options), std::move(sum.origins)};
+  LabelledMesh rounded = sum_mesh(A, B, std::move(sum));
+  const Polytope R = make_operand(rounded.mesh, "A (+) B");
+  return {erode_polytope(R, B, options), std::move(rounded.origins)};
 }
 
 std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& A,

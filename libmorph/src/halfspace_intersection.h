@@ -52,8 +52,8 @@ struct OnceFlag {
 /// thousands of lazy half-spaces, most never read, then cost neither their construction nor
 /// their destruction.
 struct HalfSpace {
-  int source = -1;   // erosion: the facet of A (its label)
-  int element = -1;  // erosion: the vertex of B that moved it inwards (its label)
+  int source = -1;             // erosion: the facet of A (its label)
+  int element = -1;            // erosion: the vertex of B that moved it inwards (its label)
   bool has_normal_dd = false;  // normal_dd is set
   bool has_offset_dd = false;  // offset_dd is set
   // Lazy exact values (an erosion's fixed-point planes, which then have both double-double
@@ -297,9 +297,9 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& halfspaces, con
 struct PreciseProbe {
   V3<double> rounded{0, 0, 0};
   std::array<bool, 3> decided{false, false, false};
-  int side = 2;     // of <n, u> - d for hs[3]
-  int compare = 2;  // of <n, u> - <n, v> for hs[3]'s normal n
-  int det = 2;      // of det(n_0, n_1, n_2)
+  int side = 2;         // of <n, u> - d for hs[3]
+  int compare = 2;      // of <n, u> - <n, v> for hs[3]'s normal n
+  int det = 2;          // of det(n_0, n_1, n_2)
   bool newton = false;  // u's precise coordinates are X / W itself (newton_meet)
 };
 /// u is the meet of the planes of hs[0], hs[1] and hs[2] (det of their normals > 0 for all
@@ -344,19 +344,27 @@ MaybePolytope erode_polytope(const Polytope& A, const Polytope& B,
 MaybePolytope erode_sum(const Polytope& S, const Polytope& A, const Polytope& B,
                         const IntersectOptions& options = {});
 
-/// The same closing from the facets of S = A (+) B (fims_facets(A, B)), without S: a facet
-/// of S is A's face plus B's face along its normal n, so its plane moved back by h_B(n) is
-/// <n, x> = <n, a_i> for any of its corners (a_i, b_j). The normals come from the operands
-/// (A's facet, B's facet, the cross product of an edge of each, or the Newell normal of the
-/// exact sums where parallel features were summed into one polygon), exactly the normals S
-/// would have, and the half-spaces, known points and guess are erode_sum's on S. When a facet
-/// of A or B is planar only within the tolerance, S may differ (merged facets): the closing
-/// goes through sum_polytope and erode_sum as before.
-MaybePolytope erode_sum(const SumFacets& sum, const Polytope& A, const Polytope& B,
-                        const IntersectOptions& options = {});
+/// The closing (A (+) B) (-) B of operands A and B, and the origin of each facet of A (+) B
+/// that a facet of the result can lie on: facet f of `eroded` lies on the facet of
+/// A (+) B labelled origins[eroded.rounded.face_source[f]] (for a convex A, the translated
+/// facets of A's facets). Three routes, in this order:
+/// - closing_input, when A's and B's facets are exactly planar (the usual case);
+/// - otherwise erode_sum on the exact sum S, when S is a valid polytope of FIMS's facets as
+///   they are (none merged);
+/// - otherwise the rounded sum (as dilate gives it), validated as an operand and eroded
+///   exactly. Where a facet is planar only within the tolerance, S's Gauss map can fold (an
+///   edge facet's exact normal just outside its neighbours' arc: not_convex), or make_polytope
+///   merges facets of S across edges that are not strictly convex, and the merged facets'
+///   planes are not S's: eroded, they cut A by a visible amount (up to 7% of a UV sphere's
+///   radius, tests/morphology_test.cpp). The rounded sum's facets are planar within the
+///   tolerance, and its closing is A within that tolerance.
+struct Closing {
+  MaybePolytope eroded;
+  std::vector<FacetOrigin> origins;
+};
+Closing close_polytope(const Polytope& A, const Polytope& B, const IntersectOptions& options = {});
 
-/// What an erosion hands to intersect_halfspaces: for tests, which compare the closing's
-/// two routes (closing_input is empty where erode_sum(sum, ...) goes through S).
+/// What an erosion hands to intersect_halfspaces (tests compare the closing's routes).
 struct ErosionInput {
   std::vector<HalfSpace> halfspaces;
   V3<double> hint{0, 0, 0};
@@ -364,6 +372,15 @@ struct ErosionInput {
   ExpectedVertices expected;
 };
 ErosionInput erode_sum_input(const Polytope& S, const Polytope& A, const Polytope& B);
+
+/// The closing's input from the facets of S = A (+) B (fims_facets(A, B)), without S: a
+/// facet of S is A's face plus B's face along its normal n, so its plane moved back by
+/// h_B(n) is <n, x> = <n, a_i> for any of its corners (a_i, b_j). The normals come from the
+/// operands (A's facet, B's facet, the cross product of an edge of each, or the Newell normal
+/// of the exact sums where parallel features were summed into one polygon), exactly the
+/// normals S would have, and the half-spaces, known points and guess are erode_sum_input's
+/// on S. Empty when a facet of A or B is planar only within the tolerance (S may then differ:
+/// merged facets); close_polytope then takes another route.
 std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& A,
                                           const Polytope& B);
 

@@ -34,10 +34,10 @@ template <class OriginOf>
 MorphResult from_rounded(detail::RoundedPolytope& p, const OriginOf& origin_of) {
   std::vector<int> source;
   // The mesh made in place: assigned, it was copied (OpenMesh has no move assignment).
-  MorphResult r{.mesh = detail::clean_mesh(p.points, p.face_begin, std::move(p.corner_vertex),
-                                           &source),
-                .origins = {},
-                .message = {}};
+  MorphResult r{
+      .mesh = detail::clean_mesh(p.points, p.face_begin, std::move(p.corner_vertex), &source),
+      .origins = {},
+      .message = {}};
   r.origins.reserve(source.size());
   for (int f : source)
     r.origins.push_back(f >= 0 ? origin_of(f) : FacetOrigin{FacetKind::translated, {}, {}});
@@ -83,11 +83,11 @@ MorphResult open(const Mesh& A, const Mesh& B, const MorphologyOptions& options)
 MorphResult close(const Mesh& A, const Mesh& B, const MorphologyOptions& options) {
   return detail::run_with_threads(options.threads, [&] {
     const Operands op = detail::make_operands(A, B);
-    const detail::SumFacets sum = detail::fims_facets(op.a, op.b);
-    detail::MaybePolytope e = detail::erode_sum(sum, op.a, op.b, kFinal);
-    if (e.reason != EmptyReason::none) return empty_result(e);
+    detail::Closing c = detail::close_polytope(op.a, op.b, kFinal);
+    if (c.eroded.reason != EmptyReason::none) return empty_result(c.eroded);
     // Each facet lies on a facet of A (+) B (its half-space's source): labelled as that one.
-    return from_rounded(e.rounded, [&](int f) { return sum.origins[e.rounded.face_source[f]]; });
+    return from_rounded(c.eroded.rounded,
+                        [&](int f) { return c.origins[c.eroded.rounded.face_source[f]]; });
   });
 }
 
