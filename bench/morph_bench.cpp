@@ -3,9 +3,11 @@
 //   morph-bench                  Table 1, morphology rows, quick scaling (a few minutes at most)
 //   morph-bench --table1         Table 1 of the FIMS paper: libmorph against the hull route
 //   morph-bench --morphology     erosion, opening and closing on the Table 1 operands
-//   morph-bench --scaling        full scaling to >= 300,000 input facets, log-log slope, peak
-//   memory morph-bench --all            all of the above with the full scaling
-//   --csv DIR                    also write table1.csv, morphology.csv, scaling.csv into DIR
+//   morph-bench --scaling        full scaling to >= 300,000 input facets of the sum (log-log
+//                                slope, peak memory) and of dilation, erosion, opening, closing
+//   morph-bench --all            all of the above with the full scaling
+//   --csv DIR                    also write table1.csv, morphology.csv, scaling.csv and
+//                                morphology_scaling.csv into DIR
 //   --markdown FILE              also write the report (Markdown tables) to FILE
 //   --samples DIR                where the sample meshes are (default: the source tree's samples/)
 //   --budget SECONDS             time aimed at per measurement, repetitions included (default 1)
@@ -19,9 +21,9 @@
 //                                apps, keeps freed memory for reuse: common/allocator.h)
 //
 // Every measurement runs once as a warm-up (not counted), then repeats as many times as
-// fit in the budget (3 to 1000 times; 5 at most in the scaling series) and reports the median. The hull route is what a user
-// without a Minkowski-sum kernel writes: all vertex sums a_i + b_j, CGAL's convex_hull_3
-// with the Epick kernel into a Surface_mesh. See docs/benchmarks.md.
+// fit in the budget (3 to 1000 times; 5 at most in the scaling series) and reports the median. The
+// hull route is what a user without a Minkowski-sum kernel writes: all vertex sums a_i + b_j,
+// CGAL's convex_hull_3 with the Epick kernel into a Surface_mesh. See docs/benchmarks.md.
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/convex_hull_3.h>
@@ -381,9 +383,12 @@ std::string result_cell(const morph::MorphResult& r) {
 
 void run_morphology(const std::vector<Pair>& pairs, const Settings& settings, Report& report) {
   using Op = morph::MorphResult (*)(const Mesh&, const Mesh&, const morph::MorphologyOptions&);
-  const std::pair<const char*, Op> ops[] = {
-      {"erode", &morph::erode}, {"open", &morph::open}, {"close", &morph::close}};
-  Table table{"Morphology: erosion, opening, closing by B scaled by " + fixed(kMorphologyScale, 2),
+  const std::pair<const char*, Op> ops[] = {{"dilate", &morph::dilate},
+                                            {"erode", &morph::erode},
+                                            {"open", &morph::open},
+                                            {"close", &morph::close}};
+  Table table{"Morphology: dilation, erosion, opening, closing by B scaled by " +
+                  fixed(kMorphologyScale, 2),
               "morphology.csv",
               {"A (facets)", "B (facets)"},
               {},
@@ -392,28 +397,33 @@ void run_morphology(const std::vector<Pair>& pairs, const Settings& settings, Re
     table.header.push_back(std::string(name) + " 1 thread (ms)");
     table.header.push_back(std::string(name) + " all (ms)");
   }
-  table.header.push_back("facets erode / open / close");
+  table.header.push_back("facets dilate / erode / open / close");
+  table.header.push_back("erode / dilate (1 thread)");
   for (const auto& [a, b_full] : pairs) {
     const Operand b{b_full.name + " x" + fixed(kMorphologyScale, 2),
                     scaled(b_full.mesh, kMorphologyScale)};
     std::cerr << "  morphology: " << a.name << " by " << b.name << '\n';
     std::vector<std::string> row{operand_cell(a), operand_cell(b)};
     std::string facets;
+    std::vector<double> one_thread;
     for (const auto& [name, op] : ops) {
-      morph::MorphResult result;
+      std::string cell;
       for (int threads : {1, 0}) {
-        const Timing t =
-            time_median([&] { result = op(a.mesh, b.mesh, {.threads = threads}); }, settings);
+        const Timing t = time_median(
+            [&] { cell = result_cell(op(a.mesh, b.mesh, {.threads = threads})); }, settings);
         row.push_back(ms(t.median_ms));
+        if (threads == 1) one_thread.push_back(t.median_ms);
       }
-      facets += (facets.empty() ? "" : " / ") + result_cell(result);
+      facets += (facets.empty() ? "" : " / ") + cell;
     }
     row.push_back(facets);
+    row.push_back(ratio(one_thread[1] / one_thread[0]));
     table.rows.push_back(row);
   }
   table.notes.push_back(
-      "Median times in milliseconds, warm-up excluded; `morph::erode`, `morph::open`, "
-      "`morph::close` with `threads = 1` and `threads = 0` (all cores). No hull route here.");
+      "Median times in milliseconds, warm-up excluded; `morph::dilate`, `morph::erode`, "
+      "`morph::open`, `morph::close` with `threads = 1` and `threads = 0` (all cores), the "
+      "result's mesh not copied. No hull route here.");
   report.table(table);
 }
 
@@ -580,6 +590,117 @@ void run_scaling(const Settings& settings, Report& report) {
 }
 
 // ---------------------------------------------------------------------------------------
+// Morphology scaling: the four operations against input size, each pair's dilation timed in
+// the same run, so that erosion, opening and closing read as multiples of it and their growth
+// as log-log slopes (the morphology issue asks them to be linear, like the dilation).
+
+struct MorphCase {
+  std::string series;
+  int parameter = 0;
+  Mesh a;
+  Mesh b;
+};
+
+// Series names. B is scaled so that it fits inside A and every erosion is a solid.
+const char* const kMorphSameLevel = "icosphere L by 0.25 rotated icosphere L";
+const char* const kMorphFixedSmall = "icosphere L by icosphere(0.25, 1)";
+const char* const kMorphUv = "UV sphere n by 0.25 snub dodecahedron";
+const char* const kMorphRandom = "random n by 0.25 random n";
+
+MorphCase make_morph_case(const std::string& series, int parameter) {
+  if (series == kMorphSameLevel) {
+    Mesh a = morph::make_icosphere(1.0, parameter);
+    Mesh b = scaled(rotated(a, kRotationAngle), kMorphologyScale);
+    return {series, parameter, std::move(a), std::move(b)};
+  }
+  if (series == kMorphFixedSmall)
+    return {series, parameter, morph::make_icosphere(1.0, parameter),
+            morph::make_icosphere(kMorphologyScale, 1)};
+  if (series == kMorphUv)
+    return {series, parameter, morph::make_uv_sphere(1.0, parameter),
+            morph::make_snub_dodecahedron(kMorphologyScale)};
+  if (series == kMorphRandom)
+    return {series, parameter, random_polytope(parameter, kSeedA),
+            scaled(random_polytope(parameter, kSeedB), kMorphologyScale)};
+  throw std::runtime_error("unknown morphology scaling series: " + series);
+}
+
+std::vector<ScalingPlan> morph_scaling_plan(bool full) {
+  if (full)
+    return {{kMorphSameLevel, {1, 2, 3, 4, 5, 6, 7}},
+            {kMorphFixedSmall, {1, 2, 3, 4, 5, 6, 7}},
+            {kMorphUv, {10, 20, 40, 80, 160, 320, 512}},
+            {kMorphRandom, {50, 200, 800, 3200, 12800, 51200, 160000}}};
+  return {{kMorphSameLevel, {1, 2, 3, 4, 5}},
+          {kMorphFixedSmall, {1, 2, 3, 4, 5}},
+          {kMorphUv, {10, 20, 40, 80, 160}},
+          {kMorphRandom, {50, 200, 800, 3200, 12800}}};
+}
+
+void run_morph_scaling(const Settings& settings, Report& report) {
+  using Op = morph::MorphResult (*)(const Mesh&, const Mesh&, const morph::MorphologyOptions&);
+  const std::pair<const char*, Op> ops[] = {{"dilate", &morph::dilate},
+                                            {"erode", &morph::erode},
+                                            {"open", &morph::open},
+                                            {"close", &morph::close}};
+  Table table{std::string("Morphology scaling: the four operations against input size") +
+                  (settings.full_scaling ? "" : " (quick; --scaling for the full range)"),
+              "morphology_scaling.csv",
+              {"series", "parameter", "input facets", "facets dilate / erode / open / close"},
+              {},
+              {}};
+  for (const auto& [name, op] : ops) table.header.push_back(std::string(name) + " 1 thread (ms)");
+  table.header.push_back("erode all threads (ms)");
+  table.header.push_back("erode / dilate");
+  table.header.push_back("open / dilate");
+  Settings few = settings;  // large cases: no more repetitions than needed
+  few.max_reps = 5;
+  for (const auto& plan : morph_scaling_plan(settings.full_scaling)) {
+    std::vector<double> inputs;
+    std::vector<std::vector<double>> times(std::size(ops));
+    for (int parameter : plan.parameters) {
+      std::cerr << "  morphology scaling: " << plan.series << ", " << parameter << '\n';
+      const MorphCase c = make_morph_case(plan.series, parameter);
+      const std::size_t input = c.a.n_faces() + c.b.n_faces();
+      std::vector<std::string> row{plan.series, std::to_string(parameter), std::to_string(input),
+                                   ""};
+      std::string facets;
+      for (std::size_t k = 0; k < std::size(ops); ++k) {
+        std::string cell;
+        const Op op = ops[k].second;
+        const Timing t =
+            time_median([&] { cell = result_cell(op(c.a, c.b, {.threads = 1})); }, few);
+        row.push_back(ms(t.median_ms));
+        times[k].push_back(t.median_ms);
+        facets += (facets.empty() ? "" : " / ") + cell;
+      }
+      row[3] = facets;
+      const Timing all = time_median([&] { morph::erode(c.a, c.b, {.threads = 0}); }, few);
+      row.push_back(ms(all.median_ms));
+      row.push_back(ratio(times[1].back() / times[0].back()));
+      row.push_back(ratio(times[2].back() / times[0].back()));
+      table.rows.push_back(row);
+      inputs.push_back(static_cast<double>(input));
+    }
+    // Fit over the cases of >= 1000 input facets: below that, fixed costs dominate.
+    std::string slopes = "- " + plan.series + ": log-log slope";
+    for (std::size_t k = 0; k < std::size(ops); ++k) {
+      std::vector<double> fx, fy;
+      for (std::size_t i = 0; i < inputs.size(); ++i)
+        if (inputs[i] >= 1000) fx.push_back(inputs[i]), fy.push_back(times[k][i]);
+      if (fx.size() >= 2)
+        slopes += std::string(k ? ", " : " ") + ops[k].first + " " + fixed(loglog_slope(fx, fy), 2);
+    }
+    table.notes.push_back(slopes + " (1 thread, inputs >= 1000 facets)");
+  }
+  table.notes.push_back(
+      "Median times in milliseconds, warm-up excluded, at most 5 repetitions; `morph::dilate`, "
+      "`morph::erode`, `morph::open`, `morph::close` with `threads = 1`, and the erosion with "
+      "`threads = 0` (all cores). The ratios divide 1-thread times of the same run.");
+  report.table(table);
+}
+
+// ---------------------------------------------------------------------------------------
 // Machine
 
 std::string cpu_model() {
@@ -680,7 +801,10 @@ int main(int argc, char** argv) {
       if (settings.table1) run_table1(pairs, settings, report);
       if (settings.morphology) run_morphology(pairs, settings, report);
     }
-    if (settings.scaling) run_scaling(settings, report);
+    if (settings.scaling) {
+      run_scaling(settings, report);
+      run_morph_scaling(settings, report);
+    }
     report.text("Load average at end " + load_average() + "\n");
     report.finish();
     return 0;
