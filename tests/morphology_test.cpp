@@ -331,7 +331,7 @@ TEST_CASE("morph: closing a convex polytope gives it back") {
 // elements folds at a vertex (its canonical build threw not_convex: "A (+) B: the facets
 // around vertex 78 do not turn convexly") or merges facets across edges that are not strictly
 // convex, whose planes then cut A by up to 7% of its radius (UV sphere n = 29 closed by a
-// small UV sphere lost 0.07 of A's vertices' positions). These pairs took each path.
+// small UV sphere: a facet more, vertices 0.07 away from A's). These pairs took each path.
 TEST_CASE("morph: closing a UV sphere gives it back where its exact sum folds or merges") {
   const struct {
     int n;
