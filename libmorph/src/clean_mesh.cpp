@@ -507,9 +507,12 @@ struct Groups {
 /// Groups facets that are coplanar to within `limit`: a facet joins a neighbour's group
 /// when all its vertices lie within `limit` of the plane of the group's largest facet,
 /// or the group joins it the other way round. Needles (facets thinner than `limit`) have
-/// no reliable plane of their own; they join a neighbour whose plane holds them.
+/// no reliable plane of their own; they join a neighbour whose plane holds them. A facet
+/// marked in `alone_only` (empty: none) stays a group of its own.
 Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
-                      const Connectivity& k, const FacetGeometry* geo, double limit) {
+                      const Connectivity& k, const FacetGeometry* geo, double limit,
+                      const std::vector<char>& alone_only) {
+  const auto may_join = [&](int f) { return alone_only.empty() || !alone_only[f]; };
   const int nf = soup.size();
   Groups out;
   std::vector<int>& next_member = out.next_member;
@@ -571,7 +574,8 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
         // joins.)
         const FacetGeometry& p = geo[a];
         if (std::abs(dot(p.normal, point[vertex[prev[edge_b]]]) - p.offset) > limit) continue;
-        if (a != b && holds_alone(a, b, edge_b)) passed[block].push_back(c);
+        if (a != b && may_join(a) && may_join(b) && holds_alone(a, b, edge_b))
+          passed[block].push_back(c);
       }
   });
   out.of.resize(nf);
@@ -594,6 +598,7 @@ Groups group_coplanar(const std::vector<V3<double>>& points, const Soup& soup,
   };
   const auto join = [&](int c) {
     const int t = k.twin[c];
+    if (!may_join(k.face[c]) || !may_join(k.face[t])) return;
     const bool tested = alone[k.face[c]] && alone[k.face[t]];
     int a = sets.find(k.face[c]), b = sets.find(k.face[t]);
     if (a == b) return;
@@ -671,12 +676,14 @@ struct MergedTwins {
 /// Passes 2 and 3 on a closed manifold soup: the polygons of its coplanar groups go to
 /// `out` (`changed` tells whether any merged; `out` is untouched if not). False when a
 /// group is not one disc or its polygon is not convex; `strict`: also when a needle finds
-/// no group. `geo`: each facet's geometry.
+/// no group. `geo`: each facet's geometry. Where a merged group's polygon is not convex,
+/// its facets are marked in `alone_only` (group_coplanar), for the caller to try again
+/// with them left as they are.
 bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, const Connectivity& k,
                     const FacetGeometry* geo, double limit, bool strict, Soup& merged,
-                    MergedTwins& merged_twins, bool& changed) {
+                    MergedTwins& merged_twins, bool& changed, std::vector<char>& alone_only) {
   const int nf = soup.size();
-  const Groups groups = group_coplanar(points, soup, k, geo, limit);
+  const Groups groups = group_coplanar(points, soup, k, geo, limit, alone_only);
   if (strict)
     for (int f = 0; f < nf; ++f)
       if (is_thin(geo[f], limit) && groups.of[f] == f) {
@@ -883,15 +890,29 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
   // Each polygon's corner test, against the plane of its group's largest facet:
   // independent, so in parallel, after the walks.
   std::atomic<bool> convex{true};
+  std::vector<char> reflex(to_test.size(), 0);  // to_test[i]'s polygon is not convex
   parallel_chunks(static_cast<int>(to_test.size()), kFacetGrain, [&](int first, int last) {
-    for (int i = first; i < last && convex.load(std::memory_order_relaxed); ++i) {
+    for (int i = first; i < last; ++i) {
       const auto [m, largest] = to_test[i];
       if (!convex_polygon(points, out.vertex.data() + out.begin[m], out.degree(m),
-                          geo[largest].normal, limit))
+                          geo[largest].normal, limit)) {
+        reflex[i] = 1;
         convex.store(false, std::memory_order_relaxed);
+      }
     }
   });
-  if (!convex.load()) return false;
+  if (!convex.load()) {
+    // Coplanar within the tolerance, yet their union bends by more than it (thin facets
+    // of an opening's tiny eroded edges beside a large facet): those groups' facets stay
+    // as they are in the next try. A facet alone that loses a vertex cannot be helped so.
+    if (alone_only.empty()) alone_only.assign(nf, 0);
+    for (std::size_t i = 0; i < to_test.size(); ++i) {
+      const int g = groups.of[to_test[i].second];
+      if (reflex[i] && groups.next_member[g] >= 0)
+        for (int f = g; f >= 0; f = groups.next_member[f]) alone_only[f] = 1;
+    }
+    return false;
+  }
   out.vertex.resize(size);
   merged_twins.twin = Ints(size);
   for (int m = 0; m < size; ++m) merged_twins.twin[m] = chain_of[k.twin[chain_end[m]]];
@@ -997,6 +1018,41 @@ struct Prepared {
 /// a closed manifold or merging fails; else (hull facets) an unmerged soup is kept.
 /// `soup` is moved into the result when it is the result, and left alone otherwise.
 /// `pre`: the soup's connectivity and geometry, if already found.
+/// Whether the surface is convex within `limit` around the facets marked in `alone_only`:
+/// at each of their corners, every vertex of the facets around the corner's vertex lies at
+/// most `limit` above the plane of each of them (needles, with no plane of their own,
+/// aside). Facets left unmerged because their group's polygon bent (merge_coplanar) pass
+/// when that bend was rounding noise; a soup that is not convex there (an L-shaped prism:
+/// its top's two halves are one plane, its inner side edge is reflex) does not, and goes to
+/// the hull as before.
+bool convex_around(const std::vector<V3<double>>& points, const Soup& soup, const Connectivity& k,
+                   const FacetGeometry* geo, double limit, const std::vector<char>& alone_only) {
+  std::vector<int> fan;
+  for (int f = 0; f < soup.size(); ++f) {
+    if (!alone_only[f]) continue;
+    for (int c = soup.begin[f]; c < soup.begin[f + 1]; ++c) {
+      fan.clear();
+      int e = c, steps = 0;
+      do {
+        fan.push_back(k.face[e]);
+        e = k.twin[k.prev[e]];
+      } while (e != c && ++steps <= static_cast<int>(soup.vertex.size()));
+      for (int g : fan) {
+        if (is_thin(geo[g], limit)) continue;
+        for (int h : fan)
+          for (int d = soup.begin[h]; d < soup.begin[h + 1]; ++d)
+            if (dot(geo[g].normal, points[soup.vertex[d]]) - geo[g].offset > limit) return false;
+      }
+    }
+  }
+  return true;
+}
+
+// Tries of merge_coplanar, each leaving the facets of the groups whose polygons were not
+// convex as they are (one try found them all in every case seen: the opening of icosphere
+// level 5 by its rotated copy scaled by 1/4 left one group).
+constexpr int kMergeRounds = 4;
+
 std::optional<std::pair<Soup, Connectivity>> simplify(const std::vector<V3<double>>& points,
                                                       Soup& soup, double limit, bool strict,
                                                       Prepared pre = {}) {
@@ -1023,7 +1079,18 @@ std::optional<std::pair<Soup, Connectivity>> simplify(const std::vector<V3<doubl
   Soup merged;
   MergedTwins merged_twins;
   bool changed = false;
-  if (!merge_coplanar(points, soup, *k, geo, limit, strict, merged, merged_twins, changed)) {
+  // Facets left as they are where a merged polygon was not convex: a few tries, each
+  // leaving more of them, before the caller's fallback.
+  std::vector<char> alone_only;
+  for (int round = 0;; ++round) {
+    const std::size_t marked = std::count(alone_only.begin(), alone_only.end(), 1);
+    if (merge_coplanar(points, soup, *k, geo, limit, strict, merged, merged_twins, changed,
+                       alone_only) &&
+        (alone_only.empty() || convex_around(points, soup, *k, geo, limit, alone_only)))
+      break;
+    if (round + 1 < kMergeRounds &&
+        static_cast<std::size_t>(std::count(alone_only.begin(), alone_only.end(), 1)) > marked)
+      continue;
     if (strict) return std::nullopt;
     return std::make_pair(std::move(soup), std::move(*k));
   }
