@@ -43,6 +43,7 @@
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <string>
@@ -483,6 +484,17 @@ double loglog_slope(const std::vector<double>& x, const std::vector<double>& y) 
   return (n * sxy - sx * sy) / (n * sxx - sx * sx);
 }
 
+// The log-log slope of a series' times over its cases of >= 1000 input facets (below that,
+// fixed costs dominate); none with fewer than two such cases.
+std::optional<double> series_slope(const std::vector<double>& inputs,
+                                   const std::vector<double>& times) {
+  std::vector<double> fx, fy;
+  for (std::size_t i = 0; i < inputs.size(); ++i)
+    if (inputs[i] >= 1000) fx.push_back(inputs[i]), fy.push_back(times[i]);
+  if (fx.size() < 2) return std::nullopt;
+  return loglog_slope(fx, fy);
+}
+
 // Peak memory of one case measured in a fresh process (this program with --peak-case), so
 // that nothing measured before (the hull route, other cases) counts.
 std::string peak_memory(const std::string& series, int parameter) {
@@ -567,12 +579,8 @@ void run_scaling(const Settings& settings, Report& report) {
       inputs.push_back(static_cast<double>(input));
       times.push_back(one.median_ms);
     }
-    // Fit over the cases of >= 1000 input facets: below that, fixed costs dominate.
-    std::vector<double> fx, fy;
-    for (std::size_t i = 0; i < inputs.size(); ++i)
-      if (inputs[i] >= 1000) fx.push_back(inputs[i]), fy.push_back(times[i]);
-    if (fx.size() >= 2)
-      slopes.push_back("- " + plan.series + ": log-log slope " + fixed(loglog_slope(fx, fy), 2) +
+    if (const auto slope = series_slope(inputs, times))
+      slopes.push_back("- " + plan.series + ": log-log slope " + fixed(*slope, 2) +
                        " (1 thread, inputs >= 1000 facets)");
     last_series = plan.series;
     last_parameter = plan.parameters.back();
@@ -682,15 +690,10 @@ void run_morph_scaling(const Settings& settings, Report& report) {
       table.rows.push_back(row);
       inputs.push_back(static_cast<double>(input));
     }
-    // Fit over the cases of >= 1000 input facets: below that, fixed costs dominate.
     std::string slopes = "- " + plan.series + ": log-log slope";
-    for (std::size_t k = 0; k < std::size(ops); ++k) {
-      std::vector<double> fx, fy;
-      for (std::size_t i = 0; i < inputs.size(); ++i)
-        if (inputs[i] >= 1000) fx.push_back(inputs[i]), fy.push_back(times[k][i]);
-      if (fx.size() >= 2)
-        slopes += std::string(k ? ", " : " ") + ops[k].first + " " + fixed(loglog_slope(fx, fy), 2);
-    }
+    for (std::size_t k = 0; k < std::size(ops); ++k)
+      if (const auto slope = series_slope(inputs, times[k]))
+        slopes += std::string(k ? ", " : " ") + ops[k].first + " " + fixed(*slope, 2);
     table.notes.push_back(slopes + " (1 thread, inputs >= 1000 facets)");
   }
   table.notes.push_back(
