@@ -433,7 +433,7 @@ void run_morphology(const std::vector<Pair>& pairs, const Settings& settings, Re
 
 struct ScalingCase {
   std::string series;
-  int parameter = 0;  // icosphere level or number of random points
+  int parameter = 0;  // icosphere level, UV sphere n or number of random points
   Mesh a;
   Mesh b;
 };
@@ -602,20 +602,13 @@ void run_scaling(const Settings& settings, Report& report) {
 // the same run, so that erosion, opening and closing read as multiples of it and their growth
 // as log-log slopes (the morphology issue asks them to be linear, like the dilation).
 
-struct MorphCase {
-  std::string series;
-  int parameter = 0;
-  Mesh a;
-  Mesh b;
-};
-
 // Series names. B is scaled so that it fits inside A and every erosion is a solid.
 const char* const kMorphSameLevel = "icosphere L by 0.25 rotated icosphere L";
 const char* const kMorphFixedSmall = "icosphere L by icosphere(0.25, 1)";
 const char* const kMorphUv = "UV sphere n by 0.25 snub dodecahedron";
 const char* const kMorphRandom = "random n by 0.25 random n";
 
-MorphCase make_morph_case(const std::string& series, int parameter) {
+ScalingCase make_morph_case(const std::string& series, int parameter) {
   if (series == kMorphSameLevel) {
     Mesh a = morph::make_icosphere(1.0, parameter);
     Mesh b = scaled(rotated(a, kRotationAngle), kMorphologyScale);
@@ -668,7 +661,7 @@ void run_morph_scaling(const Settings& settings, Report& report) {
     std::vector<std::vector<double>> times(std::size(ops));
     for (int parameter : plan.parameters) {
       std::cerr << "  morphology scaling: " << plan.series << ", " << parameter << '\n';
-      const MorphCase c = make_morph_case(plan.series, parameter);
+      const ScalingCase c = make_morph_case(plan.series, parameter);
       const std::size_t input = c.a.n_faces() + c.b.n_faces();
       std::vector<std::string> row{plan.series, std::to_string(parameter), std::to_string(input),
                                    ""};
