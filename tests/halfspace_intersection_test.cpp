@@ -8,6 +8,7 @@
 
 #include <doctest/doctest.h>
 #include <morph/io.h>
+#include <morph/structuring_element.h>
 
 #include <algorithm>
 #include <cmath>
@@ -946,6 +947,32 @@ TEST_CASE("halfspace_intersection: an erosion's guess near vertices of high degr
     CHECK((r.polytope->num_faces() < A.num_faces()) == c.vanish);
   }
 }
+// Where the repair's flips get stuck: a UV sphere's rows of quadrilaterals near a pole that
+// vanish together (each has four neighbours; the flip across the row would make an inverted
+// triangle of three nearly collinear dual points, and no neighbour has three). The repair
+// lifts such planes off the surface, flips on, and inserts them again where they cut the
+// surface (here 4 lifts with one inserted back for the cube, 11 with one for the snub
+// dodecahedron); before, it gave up and the incremental hull ran. The result is the hull's
+// and the exact route's.
+TEST_CASE("halfspace_intersection: an erosion's repair lifts planes its flips cannot reach") {
+  struct Case {
+    int n;
+    morph::Mesh B;
+  };
+  const Case cases[] = {
+      {38, morph::test::cube(0.3)},
+      {66, morph::test::scaled(sample("snub_dodecahedron.off"), 0.25)},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(c.n);
+    const Polytope A = make_operand(morph::make_uv_sphere(1.0, c.n), "A");
+    const MaybePolytope r = eroded_three_ways(A, make_operand(c.B, "B"));
+    REQUIRE(r.polytope);
+    CHECK(r.route == HullRoute::repaired);
+    CHECK(r.polytope->num_faces() < A.num_faces());
+  }
+}
+
 namespace {
 
 /// The exact value of a dyadic ExactN as a rational.

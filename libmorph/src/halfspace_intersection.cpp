@@ -1507,6 +1507,8 @@ Polytope verified_polytope(std::vector<V3<double>> points, ExactPoints exact,
 /// Actions (flips and removals) per triangle after which a repair gives up: a guess that
 /// needs more is far from the result, and the hull is then the cheaper route.
 constexpr int kRepairsPerTriangle = 1;
+/// The largest number of neighbours of a plane a repair lifts off its surface.
+constexpr int kMaxLift = 16;
 
 /// Repairs a candidate dual surface (closed, oriented, every triangle positively oriented
 /// about o) whose edges `reflex` (triangle, edge) are not locally convex: the far corner d
@@ -1514,125 +1516,447 @@ constexpr int kRepairsPerTriangle = 1;
 /// vertex (side > 0, exactly). Such an edge is flipped to (b, d) when both new triangles
 /// are positively oriented and b, d are not joined yet (a 2-2 flip: the enclosed region
 /// grows by the tetrahedron a, b, c, d); otherwise an end of the edge with three
-/// neighbours is removed (a 3-1 flip: its dual point is beneath the triangle of its
-/// neighbours, the same four points; its plane does not bound the intersection), when that
-/// triangle is positively oriented. Each action is followed by the tests of the edges
-/// around it; an edge that neither action can repair yet waits until others have acted.
+/// neighbours is removed (a 3-1 flip: the triangle of its neighbours replaces its three),
+/// when that triangle is positively oriented. Each action is followed by the tests of the
+/// edges around it; an edge that neither action can repair yet waits until others have
+/// acted.
+/// Lawson's flips for a convex hull need not finish: a reflex edge may have no valid
+/// action (a UV sphere's row of quadrilaterals that vanish in an erosion: each has four
+/// neighbours, and the flip across the row makes an inverted triangle of three nearly
+/// collinear dual points). When every waiting edge is stuck, an end of one is lifted off
+/// the surface: its neighbours' polygon is triangulated by ears (positively oriented, no
+/// other neighbour inside, no diagonal an edge already), and the flips go on.
+/// Once every edge is locally convex, the surface is the dual hull of the planes on it, and
+/// each plane lifted is inserted again (the incremental hull's step: the triangles whose
+/// vertices it cuts off replaced by a cone from it) or, when it cuts off none, left beneath
+/// the surface. (A plane removed by a 3-1 flip was beneath its neighbours' triangle; the
+/// check confirms it stays beneath the result, as any plane off the surface.)
 /// Every triangle made keeps det > 0, so the repaired surface still winds once around o.
-/// Lawson's flips for a convex hull need not finish (a reflex edge may have no valid
-/// action): false then, or after kRepairsPerTriangle actions per triangle, and the hull
-/// is computed. The result is checked exactly like any candidate (build_verified), so the
-/// repair only has to be right where it acts, not complete.
+/// False after kRepairsPerTriangle actions per triangle, or when nothing can act (the hull
+/// is then computed). The result is checked exactly like any candidate (build_verified),
+/// so the repair only has to be right where it acts, not complete.
 /// Triangles removed are dropped from `s`; triangles changed have no vertex (has_vertex).
-bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& precise,
-                    const KnownPoints& known, DualSurface& s,
-                    const std::vector<std::pair<int, int>>& reflex) {
-  RoundingGuard guard;
-  const int nt = static_cast<int>(s.corner.size());
-  std::vector<char> dead(nt, 0), changed(nt, 0);
-  // The far-plane signs of the repair's own tests, for the check after it: per slot, the
-  // far plane tested (-1: none, or the triangle changed since) and its sign.
-  std::vector<int> tested_far(3 * static_cast<std::size_t>(nt), -1);
-  std::vector<signed char> tested_sign(3 * static_cast<std::size_t>(nt));
-  const auto record = [&](int t, int k, int far, int sign) {
-    tested_far[3 * t + k] = far;
-    tested_sign[3 * t + k] = static_cast<signed char>(sign);
-  };
-  const auto forget = [&](int t) {
-    for (int k = 0; k < 3; ++k) tested_far[3 * t + k] = -1;
-  };
-  const auto next = [](int k) { return k == 2 ? 0 : k + 1; };
-  const auto prev = [](int k) { return k == 0 ? 2 : k - 1; };
-  const auto slot_of = [&](int t, int a) {
+class SurfaceRepair {
+ public:
+  SurfaceRepair(const std::vector<Plane>& planes, const PrecisePlanes& precise,
+                const KnownPoints& known, DualSurface& s)
+      : planes_(planes), precise_(precise), known_(known), s_(s) {
+    const int nt = size();
+    dead_.assign(nt, 0);
+    changed_.assign(nt, 0);
+    tested_far_.assign(3 * static_cast<std::size_t>(nt), -1);
+    tested_sign_.resize(3 * static_cast<std::size_t>(nt));
+    mark_.assign(nt, 0);
+  }
+
+  bool run(const std::vector<std::pair<int, int>>& reflex);
+
+ private:
+  using Edge = std::array<int, 3>;  // (t, a, c): the edge a -> c of triangle t
+  static int next(int k) { return k == 2 ? 0 : k + 1; }
+  static int prev(int k) { return k == 0 ? 2 : k - 1; }
+  int size() const { return static_cast<int>(s_.corner.size()); }
+
+  void record(int t, int k, int far, int sign) {
+    tested_far_[3 * t + k] = far;
+    tested_sign_[3 * t + k] = static_cast<signed char>(sign);
+  }
+  void forget(int t) {
+    for (int k = 0; k < 3; ++k) tested_far_[3 * t + k] = -1;
+  }
+  int slot_of(int t, int a) const {
     for (int k = 0; k < 3; ++k)
-      if (s.corner[t][k] == a) return k;
+      if (s_.corner[t][k] == a) return k;
     return -1;
-  };
-  const auto vertex_at = [&](int t) -> HVertex& {
-    if (!s.has_vertex[t]) {
-      s.vertex[t] = independent_vertex_of(planes, s.corner[t], known);
-      s.has_vertex[t] = 1;
+  }
+  HVertex& vertex_at(int t) {
+    if (!s_.has_vertex[t]) {
+      s_.vertex[t] = independent_vertex_of(planes_, s_.corner[t], known_);
+      s_.has_vertex[t] = 1;
     }
-    return s.vertex[t];
-  };
-  const auto positive = [&](int a, int b, int c) { return det_sign(planes, precise, a, b, c) > 0; };
-  // Sets the across of triangle t's edge x -> y to `to`; false when t has no such edge.
-  const auto relink = [&](int t, int x, int y, int to) {
+    return s_.vertex[t];
+  }
+  bool positive(int a, int b, int c) const { return det_sign(planes_, precise_, a, b, c) > 0; }
+  /// Sign of plane i at the vertex of triangle t.
+  int side_at(int i, int t) {
+    HVertex& v = vertex_at(t);
+    return known_through(known_, i, v) ? 0 : side(planes_, precise_, i, v);
+  }
+  /// Sets the across of triangle t's edge x -> y to `to`; false when t has no such edge.
+  bool relink(int t, int x, int y, int to) {
     const int k = slot_of(t, x);
-    if (k < 0 || s.corner[t][next(k)] != y) return false;
-    s.across[t][k] = to;
+    if (k < 0 || s_.corner[t][next(k)] != y) return false;
+    s_.across[t][k] = to;
     return true;
-  };
-  // The triangles around corner a of triangle t, up to `limit` + 1 (the fan is followed
-  // through the triangle across each edge leaving a); `visit` sees each one's other
-  // corner along that edge.
-  const auto around = [&](int t, int a, int limit, const auto& visit) {
+  }
+  /// The triangles around corner a of triangle t, up to `limit` + 1 (the fan is followed
+  /// through the triangle across each edge leaving a); `visit` sees each one's other corner
+  /// along that edge.
+  template <class Visit>
+  int around(int t, int a, int limit, const Visit& visit) const {
     int count = 0, u = t;
     do {
       const int k = slot_of(u, a);
       if (k < 0 || ++count > limit) return limit + 1;
-      visit(s.corner[u][next(k)]);
-      u = s.across[u][k];
+      visit(s_.corner[u][next(k)]);
+      u = s_.across[u][k];
     } while (u != t);
     return count;
-  };
-  constexpr int kMaxDegree = 1 << 12;
-  s.near.assign(planes.size(), -1);
-  std::vector<std::array<int, 3>> queue, waiting;  // (t, a, c): the edge a -> c of t
-  for (auto it = reflex.rbegin(); it != reflex.rend(); ++it)
-    queue.push_back(
-        {it->first, s.corner[it->first][it->second], s.corner[it->first][next(it->second)]});
-  const auto push_edges = [&](int t) {
-    for (int k = 2; k >= 0; --k) queue.push_back({t, s.corner[t][k], s.corner[t][next(k)]});
-  };
-  // Removes corner slot i of triangle t when it has three neighbours: t = (x, y, z),
-  // u = (y, x, d) across x -> y, w = (x, z, d) across z -> x become (y, z, d) in t.
-  const auto remove = [&](int t, int i) {
-    const int x = s.corner[t][i], y = s.corner[t][next(i)], z = s.corner[t][prev(i)];
-    const int u = s.across[t][i], w = s.across[t][prev(i)];
-    const int jx = slot_of(u, x), mx = slot_of(w, x);
-    if (u == w || jx < 0 || mx < 0) return false;
-    const int d = s.corner[u][next(jx)];
-    if (s.corner[w][prev(mx)] != d || s.across[u][jx] != w) return false;  // degree > 3
-    const int Y = s.across[u][next(jx)], Z = s.across[w][next(mx)], X = s.across[t][next(i)];
-    for (int o : {X, Y, Z})
-      if (o == t || o == u || o == w) return false;
-    if (!positive(y, z, d)) return false;
-    if (!relink(Z, d, z, t) || !relink(Y, y, d, t)) return false;
-    s.near[x] = t;  // x's dual point lies beneath t
-    changed[t] = 1;
-    s.corner[t] = {y, z, d};
-    s.across[t] = {X, Z, Y};
+  }
+  void push_edges(int t) {
+    for (int k = 2; k >= 0; --k) queue_.push_back({t, s_.corner[t][k], s_.corner[t][next(k)]});
+  }
+  /// A slot for a triangle made anew, its vertex to compute.
+  void make_triangle(int t, const std::array<int, 3>& corners) {
+    s_.corner[t] = corners;
+    s_.has_vertex[t] = 0;
+    dead_[t] = 0;
+    changed_[t] = 1;
     forget(t);
-    s.has_vertex[t] = 0;
-    dead[u] = dead[w] = 1;
-    push_edges(t);
-    return true;
+  }
+  int new_slot() {
+    s_.corner.emplace_back();
+    s_.across.emplace_back();
+    s_.vertex.emplace_back();
+    s_.has_vertex.push_back(0);
+    dead_.push_back(0);
+    changed_.push_back(1);
+    mark_.push_back(0);
+    tested_far_.insert(tested_far_.end(), 3, -1);
+    tested_sign_.insert(tested_sign_.end(), 3, 0);
+    return size() - 1;
+  }
+
+  bool remove(int t, int i);
+  bool lift(int t, int i);
+  bool lift_waiting();
+  bool insert(int x);
+  bool compact();
+
+  const std::vector<Plane>& planes_;
+  const PrecisePlanes& precise_;
+  const KnownPoints& known_;
+  DualSurface& s_;
+  std::vector<char> dead_, changed_;
+  // The far-plane signs of the repair's own tests, for the check after it: per slot, the
+  // far plane tested (-1: none, or the triangle changed since) and its sign.
+  std::vector<int> tested_far_;
+  std::vector<signed char> tested_sign_;
+  std::vector<Edge> queue_, waiting_;
+  // Planes lifted, to insert again, each with a neighbour it had (whose triangles, when it
+  // stays on the surface, start the climb: near the lifted dual point however the surface
+  // changed since).
+  std::vector<std::pair<int, int>> off_;
+  int budget_ = 0;
+  // Scratch of lift and insert.
+  std::vector<int> fan_, link_, outer_, visible_;
+  std::vector<char> clipped_, link_joined_;
+  std::vector<std::array<int, 3>> ears_;
+  std::vector<HVertex> ear_vertex_;
+  std::vector<std::pair<int, int>> horizon_;
+  std::vector<unsigned> mark_;  // per triangle: 2 stamp_ (cut off), 2 stamp_ + 1 (not)
+  unsigned stamp_ = 0;
+  static constexpr int kMaxDegree = 1 << 12;
+};
+
+// Removes corner slot i of triangle t when it has three neighbours: t = (x, y, z),
+// u = (y, x, d) across x -> y, w = (x, z, d) across z -> x become (y, z, d) in t.
+bool SurfaceRepair::remove(int t, int i) {
+  const int x = s_.corner[t][i], y = s_.corner[t][next(i)], z = s_.corner[t][prev(i)];
+  const int u = s_.across[t][i], w = s_.across[t][prev(i)];
+  const int jx = slot_of(u, x), mx = slot_of(w, x);
+  if (u == w || jx < 0 || mx < 0) return false;
+  const int d = s_.corner[u][next(jx)];
+  if (s_.corner[w][prev(mx)] != d || s_.across[u][jx] != w) return false;  // degree > 3
+  const int Y = s_.across[u][next(jx)], Z = s_.across[w][next(mx)], X = s_.across[t][next(i)];
+  for (int o : {X, Y, Z})
+    if (o == t || o == u || o == w) return false;
+  if (!positive(y, z, d)) return false;
+  if (!relink(Z, d, z, t) || !relink(Y, y, d, t)) return false;
+  s_.near[x] = t;  // x's dual point lies beneath t
+  make_triangle(t, {y, z, d});
+  s_.across[t] = {X, Z, Y};
+  dead_[u] = dead_[w] = 1;
+  push_edges(t);
+  return true;
+}
+
+// Lifts corner slot i of triangle t, with 4 to kMaxLift neighbours z_0 .. z_{k-1}
+// (counter-clockwise), off the surface: its k triangles become k - 2 ears of that polygon
+// (in the first k - 2 of their slots), each positively oriented, with no other remaining
+// neighbour inside or on it (det >= 0 against its three sides: the ears do not overlap),
+// and no new diagonal an edge already. Ears that keep x's plane (x beneath them) first:
+// those are on the dual hull of x and its neighbours, and leave fewer edges to flip.
+bool SurfaceRepair::lift(int t, int i) {
+  const int x = s_.corner[t][i];
+  fan_.clear();
+  link_.clear();
+  outer_.clear();
+  for (int w = t;;) {
+    const int m = slot_of(w, x);
+    if (m < 0 || static_cast<int>(fan_.size()) == kMaxLift) return false;
+    fan_.push_back(w);
+    link_.push_back(s_.corner[w][next(m)]);
+    outer_.push_back(s_.across[w][next(m)]);
+    w = s_.across[w][prev(m)];  // the triangle after w counter-clockwise about x
+    if (w == t) break;
+  }
+  const int k = static_cast<int>(fan_.size());
+  if (k < 4) return false;
+  for (int a = 0; a < k; ++a)
+    for (int c = 0; c < k; ++c) {
+      if (a != c && (link_[a] == link_[c] || fan_[a] == fan_[c])) return false;
+      if (outer_[a] == fan_[c]) return false;
+    }
+  // Which neighbours are joined already (around each, away from x).
+  link_joined_.assign(static_cast<std::size_t>(k) * k, 0);
+  for (int a = 0; a < k; ++a) {
+    const int degree = around(fan_[a], link_[a], kMaxDegree, [&](int w) {
+      for (int c = 0; c < k; ++c)
+        if (link_[c] == w) link_joined_[a * k + c] = link_joined_[c * k + a] = 1;
+    });
+    if (degree > kMaxDegree) return false;
+  }
+  clipped_.assign(k, 0);
+  ears_.clear();
+  ear_vertex_.clear();
+  const auto next_left = [&](int a) {
+    do a = a + 1 == k ? 0 : a + 1;
+    while (clipped_[a]);
+    return a;
   };
-  int budget = kRepairsPerTriangle * nt + 16;
-  bool progress = false;
-  while (true) {
-    if (queue.empty()) {
-      if (waiting.empty()) break;
-      if (!progress) return false;
-      progress = false;
-      std::swap(queue, waiting);
-      std::reverse(queue.begin(), queue.end());
+  const auto prev_left = [&](int a) {
+    do a = a == 0 ? k - 1 : a - 1;
+    while (clipped_[a]);
+    return a;
+  };
+  for (int left = k; left >= 3; --left) {
+    int chosen = -1;
+    HVertex chosen_vertex;
+    for (int pass = 0; pass < 2 && chosen < 0; ++pass) {
+      for (int b = 0; b < k && chosen < 0; ++b) {
+        if (clipped_[b]) continue;
+        const int a = prev_left(b), c = next_left(b);
+        if (left > 3 && link_joined_[a * k + c]) continue;
+        const int za = link_[a], zb = link_[b], zc = link_[c];
+        if (!positive(za, zb, zc)) continue;
+        bool empty = true;
+        for (int j = next_left(c); j != a && empty; j = next_left(j)) {
+          const int z = link_[j];
+          empty = det_sign(planes_, precise_, za, zb, z) < 0 ||
+                  det_sign(planes_, precise_, zb, zc, z) < 0 ||
+                  det_sign(planes_, precise_, zc, za, z) < 0;
+        }
+        if (!empty) continue;
+        HVertex v = independent_vertex_of(planes_, {za, zb, zc}, known_);
+        if (pass == 0 && !known_through(known_, x, v) && side(planes_, precise_, x, v) > 0)
+          continue;
+        chosen = b;
+        chosen_vertex = std::move(v);
+      }
+    }
+    if (chosen < 0) return false;
+    const int a = prev_left(chosen), c = next_left(chosen);
+    ears_.push_back({link_[a], link_[chosen], link_[c]});
+    ear_vertex_.push_back(std::move(chosen_vertex));
+    link_joined_[a * k + c] = link_joined_[c * k + a] = 1;
+    clipped_[chosen] = 1;
+  }
+  // The ears in the first k - 2 fan slots: across a link edge z_m -> z_m+1 lies outer[m];
+  // across a diagonal, the other ear along it.
+  const int made = k - 2;
+  for (int r = 0; r < made; ++r) {
+    make_triangle(fan_[r], ears_[r]);
+    s_.vertex[fan_[r]] = std::move(ear_vertex_[r]);
+    s_.has_vertex[fan_[r]] = 1;
+  }
+  for (int r = 0; r < made; ++r) {
+    for (int e = 0; e < 3; ++e) {
+      const int p = ears_[r][e], q = ears_[r][next(e)];
+      int to = -1;
+      for (int m = 0; m < k && to < 0; ++m)
+        if (link_[m] == p && link_[m + 1 == k ? 0 : m + 1] == q) {
+          if (!relink(outer_[m], q, p, fan_[r])) return false;
+          to = outer_[m];
+        }
+      for (int o = 0; o < made && to < 0; ++o) {
+        const int j = slot_of(fan_[o], q);
+        if (o != r && j >= 0 && ears_[o][next(j)] == p) to = fan_[o];
+      }
+      if (to < 0) return false;
+      s_.across[fan_[r]][e] = to;
+    }
+  }
+  dead_[fan_[k - 2]] = dead_[fan_[k - 1]] = 1;
+  s_.near[x] = fan_[0];
+  off_.emplace_back(x, link_[0]);
+  for (int r = 0; r < made; ++r) push_edges(fan_[r]);
+  return true;
+}
+
+// Lifts an end of a waiting edge off the surface (the one with fewer neighbours first);
+// false when none can be.
+bool SurfaceRepair::lift_waiting() {
+  for (const auto& [t, a, c] : waiting_) {
+    if (dead_[t]) continue;
+    const int i = slot_of(t, a);
+    if (i < 0 || s_.corner[t][next(i)] != c) continue;
+    const auto none = [](int) {};
+    const bool c_first = around(t, c, kMaxLift, none) < around(t, a, kMaxLift, none);
+    const int first = c_first ? next(i) : i, second = c_first ? i : next(i);
+    if (lift(t, first) || lift(t, second)) {
+      budget_ -= static_cast<int>(fan_.size());
+      return true;
+    }
+  }
+  return false;
+}
+
+// Inserts plane x into the surface, now the dual hull of the planes on it (every edge
+// locally convex): from a triangle near x's dual point, a climb to the triangle whose vertex
+// is highest along x's normal (across plateaus of equal height: the same vertex of the
+// intersection, in several triangles), which x cuts off exactly when it cuts off any. Then
+// the triangles whose vertices it cuts off (connected, on a convex surface) are replaced by
+// a cone from x over their boundary; otherwise x stays beneath the surface. False when the
+// surface turns out not convex there (the cone would not close up).
+bool SurfaceRepair::insert(int x) {
+  int u = s_.near[x];
+  for (int steps = 0; u >= 0 && dead_[u] && steps < 16; ++steps) u = s_.across[u][0];
+  if (u < 0 || dead_[u]) {
+    u = 0;
+    while (u < size() && dead_[u]) ++u;
+    if (u == size()) return false;
+  }
+  const auto compare = [&](int w, int v) {  // sign of <n_x, vertex w> - <n_x, vertex v>
+    HVertex& hw = vertex_at(w);
+    HVertex& hv = vertex_at(v);
+    int c = compare_filter(planes_, precise_, x, hw, hv);
+    if (c != 2) return c;
+    if (!hw.precise_tried || !hv.precise_tried) {
+      // Nearby vertices compared along a normal nearly parallel to their facets': mostly
+      // decided by the precise stage, which compare_filter uses once both vertices have it.
+      {
+        RoundingGuard nearest(CGAL_FE_TONEAREST);
+        if (!hw.precise_tried) make_precise(precise_, hw);
+        if (!hv.precise_tried) make_precise(precise_, hv);
+      }
+      c = compare_filter(planes_, precise_, x, hw, hv);
+      if (c != 2) return c;
+    }
+    make_exact(planes_, hw);
+    make_exact(planes_, hv);
+    return compare_exact(planes_[x], hw, hv);
+  };
+  constexpr int kMaxPlateau = 256;
+  visible_.assign(1, u);  // (the plateau, here)
+  for (std::size_t q = 0; q < visible_.size();) {
+    const int v = visible_[q];
+    int higher = -1;
+    for (int k = 0; k < 3 && higher < 0; ++k) {
+      const int w = s_.across[v][k];
+      if (std::find(visible_.begin(), visible_.end(), w) != visible_.end()) continue;
+      const int c = compare(w, v);
+      if (c > 0) higher = w;
+      if (c == 0) visible_.push_back(w);
+    }
+    if (higher >= 0) {
+      u = higher;
+      visible_.assign(1, u);
+      q = 0;
       continue;
     }
-    const auto [t, a, c] = queue.back();
-    queue.pop_back();
-    if (dead[t]) continue;
+    if (visible_.size() > kMaxPlateau) return false;
+    ++q;
+  }
+  if (side_at(x, u) <= 0) {
+    s_.near[x] = u;
+    return true;
+  }
+  // The triangles x cuts off, and the edges around them.
+  ++stamp_;
+  const unsigned cut = 2 * stamp_, kept = 2 * stamp_ + 1;
+  visible_.assign(1, u);
+  mark_[u] = cut;
+  horizon_.clear();
+  for (std::size_t q = 0; q < visible_.size(); ++q) {
+    const int v = visible_[q];
+    for (int k = 0; k < 3; ++k) {
+      const int w = s_.across[v][k];
+      if (mark_[w] == cut) continue;
+      if (mark_[w] != kept) {
+        if (side_at(x, w) > 0) {
+          mark_[w] = cut;
+          visible_.push_back(w);
+          continue;
+        }
+        mark_[w] = kept;
+      }
+      horizon_.emplace_back(v, k);
+    }
+  }
+  // One triangle (a, b, x) per horizon edge a -> b, in the cut-off triangles' slots first
+  // (a disk's boundary has two edges more than it has triangles).
+  const int nh = static_cast<int>(horizon_.size()), nv = static_cast<int>(visible_.size());
+  ears_.resize(nh);
+  outer_.resize(nh);
+  for (int h = 0; h < nh; ++h) {
+    const auto [v, k] = horizon_[h];
+    ears_[h] = {s_.corner[v][k], s_.corner[v][next(k)], x};
+    outer_[h] = s_.across[v][k];
+    if (!positive(ears_[h][0], ears_[h][1], x)) return false;
+  }
+  for (int g = 0; g < nh; ++g)
+    for (int h = g + 1; h < nh; ++h)
+      if (ears_[g][0] == ears_[h][0]) return false;  // not a simple cycle
+  fan_.clear();
+  for (int h = 0; h < nh; ++h) fan_.push_back(h < nv ? visible_[h] : new_slot());
+  for (int h = nh; h < nv; ++h) dead_[visible_[h]] = 1;
+  for (int h = 0; h < nh; ++h) make_triangle(fan_[h], ears_[h]);
+  for (int h = 0; h < nh; ++h) {
+    const int r = fan_[h], a = ears_[h][0], b = ears_[h][1];
+    if (!relink(outer_[h], b, a, r)) return false;
+    int after = -1;  // the triangle (b, c, x)
+    for (int g = 0; g < nh && after < 0; ++g)
+      if (ears_[g][0] == b) after = fan_[g];
+    if (after < 0) return false;
+    s_.across[r][0] = outer_[h];
+    s_.across[r][1] = after;
+    s_.across[after][2] = r;
+  }
+  return true;
+}
+
+bool SurfaceRepair::run(const std::vector<std::pair<int, int>>& reflex) {
+  RoundingGuard guard;
+  const int nt = size();
+  s_.near.assign(planes_.size(), -1);
+  for (auto it = reflex.rbegin(); it != reflex.rend(); ++it)
+    queue_.push_back(
+        {it->first, s_.corner[it->first][it->second], s_.corner[it->first][next(it->second)]});
+  budget_ = kRepairsPerTriangle * nt + 16;
+  bool progress = false;
+  while (true) {
+    if (queue_.empty()) {
+      if (waiting_.empty()) break;
+      if (!progress && !lift_waiting()) return false;
+      progress = false;
+      // The waiting edges are tested again, after the edges of a lift (the stack's top).
+      queue_.insert(queue_.begin(), waiting_.rbegin(), waiting_.rend());
+      waiting_.clear();
+      continue;
+    }
+    const auto [t, a, c] = queue_.back();
+    queue_.pop_back();
+    if (dead_[t]) continue;
     const int i = slot_of(t, a);
-    if (i < 0 || s.corner[t][next(i)] != c) continue;  // changed meanwhile
-    const int u = s.across[t][i], j = slot_of(u, c);
-    if (j < 0 || s.corner[u][next(j)] != a) return false;  // not a closed oriented surface
-    const int b = s.corner[t][prev(i)], d = s.corner[u][prev(j)];
-    HVertex& v = vertex_at(t);
+    if (i < 0 || s_.corner[t][next(i)] != c) continue;  // changed meanwhile
+    const int u = s_.across[t][i], j = slot_of(u, c);
+    if (j < 0 || s_.corner[u][next(j)] != a) return false;  // not a closed oriented surface
+    const int b = s_.corner[t][prev(i)], d = s_.corner[u][prev(j)];
     // (W > 0: a known point, or the meet of positively oriented planes; independent_vertex_of
     // and the checks' side tests assume the same.)
     {
-      const int sd = known_through(known, d, v) ? 0 : side(planes, precise, d, v);
+      const int sd = side_at(d, t);
       if (sd <= 0) {
         // (Plane b at u's vertex has the same sign: see build_verified's far-plane tests.)
         record(t, i, d, sd);
@@ -1640,9 +1964,9 @@ bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& preci
         continue;
       }
     }
-    if (--budget < 0) return false;
-    const int X1 = s.across[t][next(i)], X2 = s.across[t][prev(i)], Y1 = s.across[u][next(j)],
-              Y2 = s.across[u][prev(j)];
+    if (--budget_ < 0) return false;
+    const int X1 = s_.across[t][next(i)], X2 = s_.across[t][prev(i)], Y1 = s_.across[u][next(j)],
+              Y2 = s_.across[u][prev(j)];
     // (A fan too long to follow counts as joined: no flip that could double an edge.)
     bool joined = b == d;
     if (!joined && around(t, b, kMaxDegree, [&](int w) { joined = joined || w == d; }) > kMaxDegree)
@@ -1652,22 +1976,18 @@ bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& preci
       if (o == t || o == u) outer_ok = false;
     if (!joined && outer_ok && positive(a, d, b) && positive(d, c, b)) {
       if (!relink(Y1, d, a, t) || !relink(X1, b, c, u)) return false;
-      s.corner[t] = {a, d, b};
-      s.across[t] = {Y1, u, X2};
-      s.corner[u] = {d, c, b};
-      s.across[u] = {Y2, X1, t};
+      make_triangle(t, {a, d, b});
+      s_.across[t] = {Y1, u, X2};
+      make_triangle(u, {d, c, b});
+      s_.across[u] = {Y2, X1, t};
       // The new diagonal's sign is the opposite of the test that flipped it (its four
       // planes in an odd order), as in triangulate_polygon.
-      forget(t);
-      forget(u);
       record(t, 1, c, -1);
       record(u, 2, a, -1);
-      s.has_vertex[t] = s.has_vertex[u] = 0;
-      changed[t] = changed[u] = 1;
-      queue.push_back({t, b, a});
-      queue.push_back({u, c, b});
-      queue.push_back({u, d, c});
-      queue.push_back({t, a, d});
+      queue_.push_back({t, b, a});
+      queue_.push_back({u, c, b});
+      queue_.push_back({u, d, c});
+      queue_.push_back({t, a, d});
       progress = true;
       continue;
     }
@@ -1675,62 +1995,87 @@ bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& preci
       progress = true;
       continue;
     }
-    ++budget;
-    waiting.push_back({t, a, c});
+    ++budget_;
+    waiting_.push_back({t, a, c});
   }
-  // Drop the removed triangles: those beyond the kept count fill the removed ones' slots
-  // below it (fewer vertex moves than shifting all later ones; the check's result does not
-  // depend on the triangles' order).
+  // Every edge is locally convex: the planes lifted go back where they cut it.
+  if (!off_.empty()) {
+    std::vector<int> triangle_at(planes_.size(), -1);
+    for (int t = 0; t < size(); ++t)
+      if (!dead_[t])
+        for (const int p : s_.corner[t]) triangle_at[p] = t;
+    for (const auto& [x, neighbour] : off_) {
+      if (triangle_at[neighbour] >= 0 && !dead_[triangle_at[neighbour]])
+        s_.near[x] = triangle_at[neighbour];
+      if (!insert(x)) return false;
+    }
+  }
+  return compact();
+}
+
+// Drops the removed triangles and carries the far-plane signs that still hold over to
+// s_.far_side.
+bool SurfaceRepair::compact() {
+  const int nt = size();
+  // The triangles beyond the kept count fill the removed ones' slots below it (fewer
+  // vertex moves than shifting all later ones; the check's result does not depend on the
+  // triangles' order).
   std::vector<int> index(nt, -1);
   int kept = 0;
-  for (int t = 0; t < nt; ++t) kept += !dead[t];
+  for (int t = 0; t < nt; ++t) kept += !dead_[t];
   for (int t = 0, hole = 0; t < nt; ++t) {
-    if (dead[t]) continue;
+    if (dead_[t]) continue;
     if (t < kept) {
       index[t] = t;
     } else {
-      while (!dead[hole]) ++hole;
+      while (!dead_[hole]) ++hole;
       index[t] = hole++;
     }
   }
-  for (int& t : s.near) {
+  for (int& t : s_.near) {
     // (A triangle removed since: its dual point's neighbour, still near.)
-    if (t >= 0 && dead[t]) t = s.across[t][0];
-    if (t >= 0) t = index[t];
+    if (t >= 0 && dead_[t]) t = s_.across[t][0];
+    if (t >= 0) t = dead_[t] ? -1 : index[t];
   }
   // The far-plane signs stay for the edges between unchanged triangles, and the repair's
   // own where the far plane is still the one tested (the same four planes).
   std::vector<signed char> far_side(3 * static_cast<std::size_t>(kept), 2);
   for (int t = 0; t < nt; ++t) {
-    if (dead[t]) continue;
+    if (dead_[t]) continue;
     for (int k = 0; k < 3; ++k) {
-      const int u = s.across[t][k];
-      if (!changed[t] && !changed[u]) {
-        far_side[3 * index[t] + k] = s.far_side[3 * t + k];
-      } else if (tested_far[3 * t + k] >= 0 && s.far_corner(t, k) == tested_far[3 * t + k]) {
-        far_side[3 * index[t] + k] = tested_sign[3 * t + k];
+      const int u = s_.across[t][k];
+      if (!changed_[t] && !changed_[u]) {
+        far_side[3 * index[t] + k] = s_.far_side[3 * t + k];
+      } else if (tested_far_[3 * t + k] >= 0 && s_.far_corner(t, k) == tested_far_[3 * t + k]) {
+        far_side[3 * index[t] + k] = tested_sign_[3 * t + k];
       }
     }
   }
-  s.far_side = std::move(far_side);
-  s.oriented = true;
+  s_.far_side = std::move(far_side);
+  s_.oriented = true;
   for (int t = 0; t < nt; ++t) {
     // (Each slot is written once, from itself or from a kept triangle beyond `kept`.)
-    if (dead[t]) continue;
+    if (dead_[t]) continue;
     const int r = index[t];
-    s.corner[r] = s.corner[t];
-    s.across[r] = {index[s.across[t][0]], index[s.across[t][1]], index[s.across[t][2]]};
-    if (r != t) s.vertex[r] = std::move(s.vertex[t]);
-    s.has_vertex[r] = s.has_vertex[t];
+    s_.corner[r] = s_.corner[t];
+    s_.across[r] = {index[s_.across[t][0]], index[s_.across[t][1]], index[s_.across[t][2]]};
+    if (r != t) s_.vertex[r] = std::move(s_.vertex[t]);
+    s_.has_vertex[r] = s_.has_vertex[t];
   }
-  s.corner.resize(kept);
-  s.across.resize(kept);
-  s.vertex.resize(kept);
-  s.has_vertex.resize(kept);
-  for (const auto& a : s.across)
+  s_.corner.resize(kept);
+  s_.across.resize(kept);
+  s_.vertex.resize(kept);
+  s_.has_vertex.resize(kept);
+  for (const auto& a : s_.across)
     for (int x : a)
       if (x < 0) return false;
   return kept >= 4;
+}
+
+bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& precise,
+                    const KnownPoints& known, DualSurface& s,
+                    const std::vector<std::pair<int, int>>& reflex) {
+  return SurfaceRepair(planes, precise, known, s).run(reflex);
 }
 
 /// The check's ray from o: r, with u = e_k x r and w = r x u exactly orthogonal to it, and
@@ -2872,6 +3217,10 @@ struct PolygonScratch {
 
 /// Flips per corner after which a polygon's triangulation gives up: Lawson's flips may
 /// take O(k^2) on a vertex of A of high degree, and the hull is then the cheaper route.
+/// (Where planes of the polygon vanish, a UV sphere's pole with its facets moved by
+/// several vertices of B, they do not end: a repair could lift those planes off, but
+/// from a pole of 120 planes or more it takes longer than the hull, to 8 s at 160,000
+/// planes, mostly in its rounds over the waiting edges.)
 constexpr int kFlipsPerCorner = 4;
 
 /// Triangulates the polygon of planes p[0 .. k) (counter-clockwise seen from outside) so
