@@ -962,6 +962,9 @@ TEST_CASE("halfspace_intersection: an erosion's repair lifts planes its flips ca
   const Case cases[] = {
       {38, morph::test::cube(0.3)},
       {66, morph::test::scaled(sample("snub_dodecahedron.off"), 0.25)},
+      // The pole's polygon of 98 planes stops flipping (kFlipsPerCorner; the guess was
+      // given up there) and the repair goes on.
+      {98, morph::test::cube(0.3)},
   };
   for (const Case& c : cases) {
     CAPTURE(c.n);
