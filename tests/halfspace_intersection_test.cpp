@@ -370,7 +370,9 @@ TEST_CASE("halfspace_intersection: known points and an expected result give the 
   CHECK(difference(with_known, plain) == "");
   CHECK(rounded_from_exact(with_known));
   // The result's own fans as the guess: taken and checked; as a guess for more planes
-  // (one cuts the apex off), rejected, and the hull gives the right answer.
+  // (one cuts the apex off), the check finds the plane it left out cutting it, and the
+  // repair inserts it (or, with split off, where a polygon must be one vertex, the hull
+  // computes the result): the same result.
   const Polytope& p = *plain.polytope;
   ExpectedVertices expected;
   expected.begin = p.fan_begin;
@@ -381,8 +383,12 @@ TEST_CASE("halfspace_intersection: known points and an expected result give the 
   std::vector<HalfSpace> cut = hs;
   cut.push_back(plane(0, 0, 1, apex.z - Exact(1) / Exact(100), static_cast<int>(cut.size())));
   const MaybePolytope wrong = intersect_halfspaces(cut, {0, 0, 0}, {}, {}, expected);
-  CHECK(wrong.route == HullRoute::incremental);
+  CHECK(wrong.route == HullRoute::repaired);
   CHECK(difference(wrong, checked(cut)) == "");
+  expected.split = false;
+  const MaybePolytope unsplit = intersect_halfspaces(cut, {0, 0, 0}, {}, {}, expected);
+  CHECK(unsplit.route == HullRoute::incremental);
+  CHECK(difference(unsplit, checked(cut)) == "");
 }
 
 // A guess whose triangles do not close into a surface (a vertex's polygon left out, one
@@ -569,9 +575,18 @@ TEST_CASE("halfspace_intersection: a closing from the sum's facets, without the 
     // (S has no merged facets here: close_polytope takes S itself where closing_input
     // declines.)
     REQUIRE(S.num_faces() == sum.num_faces());
-    const MaybePolytope via_sum = close_polytope(A, B).eroded, via_s = erode_sum(S, A, B);
+    // (Where closing_input declines, close_polytope splits A's vertices of S's guess: the
+    // check's repair then takes off what vanishes and puts in what cuts, not the hull.)
+    ErosionInput split = erode_sum_input(S, A, B);
+    split.expected.split = !got;
+    const MaybePolytope via_sum = close_polytope(A, B).eroded,
+                        via_s = intersect_halfspaces(split.halfspaces, split.hint, {}, split.known,
+                                                     split.expected);
     CHECK(difference(via_sum, via_s) == "");
     CHECK(via_sum.route == via_s.route);
+    if (!got) CHECK(via_sum.route != HullRoute::incremental);
+    if (c.name.starts_with("uvsphere")) CHECK(via_sum.route == HullRoute::repaired);
+    CHECK(difference(via_sum, erode_sum(S, A, B)) == "");
     CHECK(rounded_from_exact(via_sum));
     CHECK(via_sum.rounded.face_element == via_s.rounded.face_element);
     if (!got) continue;

@@ -474,8 +474,14 @@ Closing close_polytope(const Polytope& A, const Polytope& B, const IntersectOpti
   } catch (const not_convex&) {
     // S's normals fold: the rounded route below.
   }
-  if (S && S->num_faces() == sum.num_faces())
-    return {erode_sum(*S, A, B, options), std::move(sum.origins)};
+  if (S && S->num_faces() == sum.num_faces()) {
+    // A's vertices split where its facets are only nearly planar: the guess goes on from
+    // there (split), its flips and the check's repair taking off the facets of S that
+    // vanish and putting in those that cut it.
+    ErosionInput in = erode_sum_input(*S, A, B);
+    in.expected.split = true;
+    return {intersect(in, options), std::move(sum.origins)};
+  }
   LabelledMesh rounded = sum_mesh(A, B, std::move(sum));
   const Polytope R = make_operand(rounded.mesh, "A (+) B");
   return {erode_polytope(R, B, options), std::move(rounded.origins)};

@@ -1552,6 +1552,10 @@ class SurfaceRepair {
   }
 
   bool run(const std::vector<std::pair<int, int>>& reflex);
+  /// Inserts planes that cut the surface, which is convex (every edge locally convex), each
+  /// (plane, triangle) with a triangle whose vertex it cuts off (insert), and drops the
+  /// triangles removed.
+  bool insert_cutting(const std::vector<std::pair<int, int>>& cutting);
 
  private:
   using Edge = std::array<int, 3>;  // (t, a, c): the edge a -> c of triangle t
@@ -2015,6 +2019,16 @@ bool SurfaceRepair::run(const std::vector<std::pair<int, int>>& reflex) {
         s_.near[x] = triangle_at[neighbour];
       if (!insert(x)) return false;
     }
+  }
+  return compact();
+}
+
+bool SurfaceRepair::insert_cutting(const std::vector<std::pair<int, int>>& cutting) {
+  RoundingGuard guard;
+  s_.near.assign(planes_.size(), -1);
+  for (const auto& [x, t] : cutting) {
+    s_.near[x] = t;
+    if (!insert(x)) return false;
   }
   return compact();
 }
@@ -2505,6 +2519,9 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       if (vertex[v].known >= 0) vertex_at_point[vertex[v].known] = v;
   }
   std::vector<std::vector<int>> touched(others.size());
+  // Per plane off the surface that cuts it, where a guess may be repaired: the vertex it
+  // cuts off (the climb's end), else -1.
+  std::vector<int> cut(can_repair ? others.size() : 0, -1);
   parallel_chunks(static_cast<int>(others.size()), 64, [&](int begin, int end) {
     RoundingGuard guard;
     int u = 0;
@@ -2544,7 +2561,12 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
         }
       }
       const int sd = u_on ? 0 : side_of(i, u);
-      if (sd > 0) ok = false;
+      if (sd > 0) {
+        if (can_repair)
+          cut[j] = u;
+        else
+          ok = false;
+      }
       if (sd != 0) continue;
       plateau.assign(1, u);
       for (std::size_t q = 0; q < plateau.size(); ++q)
@@ -2559,6 +2581,35 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     }
   });
   if (!ok) return std::nullopt;
+  if (std::any_of(cut.begin(), cut.end(), [](int v) { return v >= 0; })) {
+    // Planes the guess left out that cut it (a closing of a UV sphere, whose result is not
+    // quite A: facets of B or edge facets of S just outside A's nearly planar facets). The
+    // candidate is convex here (every edge locally convex): they are inserted as the
+    // incremental hull would, and the result checked again.
+    std::vector<int> triangle_of(nv, -1);
+    bool identity = nv == nt;
+    for (int t = 0; t < nt; ++t) {
+      triangle_of[group[t]] = t;
+      identity = identity && group[t] == t;
+    }
+    std::vector<std::pair<int, int>> cutting;
+    for (std::size_t j = 0; j < others.size(); ++j)
+      if (cut[j] >= 0) cutting.emplace_back(others[j], triangle_of[cut[j]]);
+    // The triangles' vertices, where each is its own group; otherwise made again.
+    if (identity) {
+      s.vertex = std::move(vertex);
+      s.has_vertex.assign(nt, 1);
+    } else {
+      s.vertex.clear();
+      s.vertex.resize(nt);
+      s.has_vertex.assign(nt, 0);
+    }
+    s.far_side = std::move(far_side);
+    if (!SurfaceRepair(planes, precise, known, s).insert_cutting(cutting)) return std::nullopt;
+    *repaired = true;
+    return build_verified(hs, planes, precise, known, std::move(s), options, owner, nullptr,
+                          &check_ray);
+  }
   // Verified. The half-spaces through each vertex (key[key_begin[v] ..), sorted, once):
   // those of its triangles and the touching ones. A touching plane along a whole facet is
   // that facet's plane given twice: the facet takes the smaller index.

@@ -268,8 +268,11 @@ struct ExpectedVertices {
   std::vector<int> begin;  // size V + 1, or empty
   std::vector<int> facets;
   // false: each polygon is expected to be one vertex of the result, its planes through one
-  // known point (a closing's A); a polygon that is not gives the guess up at once (A's
-  // facets only nearly planar: the result is not A, and flips would not find it either).
+  // known point (a closing's A, its facets exactly planar); a polygon that is not gives the
+  // guess up at once, and the check computes no triangle's vertex to keep (no repair).
+  // true: polygons split as their planes meet, and the check's repair takes off planes
+  // that vanish and puts in planes the guess left out that cut it (a closing of an A whose
+  // facets are only nearly planar).
   bool split = true;
   bool empty() const { return begin.empty(); }
 };
@@ -349,8 +352,8 @@ MaybePolytope erode_sum(const Polytope& S, const Polytope& A, const Polytope& B,
 /// A (+) B labelled origins[eroded.rounded.face_source[f]] (for a convex A, the translated
 /// facets of A's facets). Three routes, in this order:
 /// - closing_input, when A's and B's facets are exactly planar (the usual case);
-/// - otherwise erode_sum on the exact sum S, when S is a valid polytope of FIMS's facets as
-///   they are (none merged);
+/// - otherwise erode_sum's input on the exact sum S, when S is a valid polytope of FIMS's
+///   facets as they are (none merged), its guess split (ExpectedVertices::split);
 /// - otherwise the rounded sum (as dilate gives it), validated as an operand and eroded
 ///   exactly. Where a facet is planar only within the tolerance, S's Gauss map can fold (an
 ///   edge facet's exact normal just outside its neighbours' arc: not_convex), or make_polytope
