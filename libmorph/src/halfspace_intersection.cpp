@@ -1865,17 +1865,19 @@ bool SurfaceRepair::insert(int x) {
   };
   constexpr int kMaxPlateau = 256;
   visible_.assign(1, u);  // (the plateau, here)
+  int below = -1;         // the triangle the climb came from: lower than the plateau
   for (std::size_t q = 0; q < visible_.size();) {
     const int v = visible_[q];
     int higher = -1;
     for (int k = 0; k < 3 && higher < 0; ++k) {
       const int w = s_.across[v][k];
-      if (std::find(visible_.begin(), visible_.end(), w) != visible_.end()) continue;
+      if (w == below || std::find(visible_.begin(), visible_.end(), w) != visible_.end()) continue;
       const int c = compare(w, v);
       if (c > 0) higher = w;
       if (c == 0) visible_.push_back(w);
     }
     if (higher >= 0) {
+      below = v;
       u = higher;
       visible_.assign(1, u);
       q = 0;
