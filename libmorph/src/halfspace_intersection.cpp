@@ -1613,7 +1613,8 @@ class SurfaceRepair {
   void push_edges(int t) {
     for (int k = 2; k >= 0; --k) queue_.push_back({t, s_.corner[t][k], s_.corner[t][next(k)]});
   }
-  /// A slot for a triangle made anew, its vertex to compute.
+  /// Triangle t made anew with these corners (its links set by the caller): its vertex to
+  /// compute, its tests forgotten.
   void make_triangle(int t, const std::array<int, 3>& corners) {
     s_.corner[t] = corners;
     s_.has_vertex[t] = 0;
@@ -1621,6 +1622,7 @@ class SurfaceRepair {
     changed_[t] = 1;
     forget(t);
   }
+  /// A slot for one more triangle (an insertion's cone has two more than it replaces).
   int new_slot() {
     s_.corner.emplace_back();
     s_.across.emplace_back();
