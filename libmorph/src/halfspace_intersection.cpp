@@ -1532,13 +1532,14 @@ constexpr int kMaxLift = 16;
 /// each plane lifted is inserted again (the incremental hull's step: the triangles whose
 /// vertices it cuts off replaced by a cone from it) or, when it cuts off none, left beneath
 /// the surface; one whose ears all kept it beneath them needs neither (30% of the lifts of
-/// an icosphere of 327,680 facets eroded by a small icosphere). (A plane removed by a 3-1 flip was
-/// beneath its neighbours' triangle; the check confirms it stays beneath the result, as any plane
-/// off the surface.) Every triangle made keeps det > 0, so the repaired surface still winds once
-/// around o. False after kRepairsPerTriangle actions per triangle, or when nothing can act (the
-/// hull is then computed). The result is checked exactly like any candidate (build_verified), so
-/// the repair only has to be right where it acts, not complete. Triangles removed are dropped from
-/// `s`; triangles changed have no vertex (has_vertex).
+/// an icosphere of 327,680 facets eroded by a small icosphere). (A plane removed by a 3-1
+/// flip was beneath its neighbours' triangle; the check confirms it stays beneath the
+/// result, as any plane off the surface.)
+/// Every triangle made keeps det > 0, so the repaired surface still winds once around o.
+/// False after kRepairsPerTriangle actions per triangle, or when nothing can act (the hull
+/// is then computed). The result is checked exactly like any candidate (build_verified), so
+/// the repair only has to be right where it acts, not complete.
+/// Triangles removed are dropped from `s`; triangles changed have no vertex (has_vertex).
 class SurfaceRepair {
  public:
   SurfaceRepair(const std::vector<Plane>& planes, const PrecisePlanes& precise,
@@ -1741,32 +1742,38 @@ bool SurfaceRepair::lift(int t, int i) {
   };
   bool beneath = true;  // every ear keeps x's plane
   for (int left = k; left >= 3; --left) {
-    int chosen = -1;
-    HVertex chosen_vertex;
-    for (int pass = 0; pass < 2 && chosen < 0; ++pass) {
-      for (int b = 0; b < k && chosen < 0; ++b) {
-        if (clipped_[b]) continue;
-        const int a = prev_left(b), c = next_left(b);
-        if (left > 3 && link_joined_[a * k + c]) continue;
-        const int za = link_[a], zb = link_[b], zc = link_[c];
-        if (!positive(za, zb, zc)) continue;
-        bool empty = true;
-        for (int j = next_left(c); j != a && empty; j = next_left(j)) {
-          const int z = link_[j];
-          empty = det_sign(planes_, precise_, za, zb, z) < 0 ||
-                  det_sign(planes_, precise_, zb, zc, z) < 0 ||
-                  det_sign(planes_, precise_, zc, za, z) < 0;
-        }
-        if (!empty) continue;
-        HVertex v = independent_vertex_of(planes_, {za, zb, zc}, known_);
-        if (pass == 0 && !known_through(known_, x, v) && side(planes_, precise_, x, v) > 0)
-          continue;
+    // The first valid ear that keeps x's plane, else the first valid ear.
+    int chosen = -1, fallback = -1;
+    HVertex chosen_vertex, fallback_vertex;
+    for (int b = 0; b < k && chosen < 0; ++b) {
+      if (clipped_[b]) continue;
+      const int a = prev_left(b), c = next_left(b);
+      if (left > 3 && link_joined_[a * k + c]) continue;
+      const int za = link_[a], zb = link_[b], zc = link_[c];
+      if (!positive(za, zb, zc)) continue;
+      bool empty = true;
+      for (int j = next_left(c); j != a && empty; j = next_left(j)) {
+        const int z = link_[j];
+        empty = det_sign(planes_, precise_, za, zb, z) < 0 ||
+                det_sign(planes_, precise_, zb, zc, z) < 0 ||
+                det_sign(planes_, precise_, zc, za, z) < 0;
+      }
+      if (!empty) continue;
+      HVertex v = independent_vertex_of(planes_, {za, zb, zc}, known_);
+      if (known_through(known_, x, v) || side(planes_, precise_, x, v) <= 0) {
         chosen = b;
         chosen_vertex = std::move(v);
-        beneath = beneath && pass == 0;
+      } else if (fallback < 0) {
+        fallback = b;
+        fallback_vertex = std::move(v);
       }
     }
-    if (chosen < 0) return false;
+    if (chosen < 0) {
+      if (fallback < 0) return false;
+      chosen = fallback;
+      chosen_vertex = std::move(fallback_vertex);
+      beneath = false;
+    }
     const int a = prev_left(chosen), c = next_left(chosen);
     ears_.push_back({link_[a], link_[chosen], link_[c]});
     ear_vertex_.push_back(std::move(chosen_vertex));
