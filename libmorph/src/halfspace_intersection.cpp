@@ -1641,6 +1641,7 @@ class SurfaceRepair {
   bool lift(int t, int i);
   bool lift_waiting();
   bool insert(int x);
+  bool walk_to_cone(int x, int& u);
   bool compact();
 
   const std::vector<Plane>& planes_;
@@ -1658,6 +1659,7 @@ class SurfaceRepair {
   // changed since).
   std::vector<std::pair<int, int>> off_;
   int budget_ = 0;
+  int last_ = -1;  // where the last insertion's walk ended (a start when x's own is gone)
   // Scratch of lift and insert.
   std::vector<int> fan_, link_, outer_, visible_;
   std::vector<char> clipped_, link_joined_;
@@ -1838,15 +1840,17 @@ bool SurfaceRepair::lift_waiting() {
 }
 
 // Inserts plane x into the surface, now the dual hull of the planes on it (every edge
-// locally convex): from a triangle near x's dual point, a climb to the triangle whose vertex
-// is highest along x's normal (across plateaus of equal height: the same vertex of the
-// intersection, in several triangles), which x cuts off exactly when it cuts off any. Then
+// locally convex): from a triangle near x's dual point (or where the last insertion ended),
+// a walk to the triangle whose vertex is highest along x's normal (walk_to_cone; where it
+// does not arrive, a climb on from there, across plateaus of equal height: the same vertex
+// of the intersection, in several triangles), which x cuts off exactly when it cuts off any. Then
 // the triangles whose vertices it cuts off (connected, on a convex surface) are replaced by
 // a cone from x over their boundary; otherwise x stays beneath the surface. False when the
 // surface turns out not convex there (the cone would not close up).
 bool SurfaceRepair::insert(int x) {
   int u = s_.near[x];
   for (int steps = 0; u >= 0 && dead_[u] && steps < 16; ++steps) u = s_.across[u][0];
+  if ((u < 0 || dead_[u]) && last_ >= 0 && !dead_[last_]) u = last_;
   if (u < 0 || dead_[u]) {
     u = 0;
     while (u < size() && dead_[u]) ++u;
@@ -1872,10 +1876,13 @@ bool SurfaceRepair::insert(int x) {
     make_exact(planes_, hv);
     return compare_exact(planes_[x], hw, hv);
   };
+  // The walk's end is the highest vertex: the climb only goes on where it did not arrive.
+  const bool arrived = walk_to_cone(x, u);
+  last_ = u;
   constexpr int kMaxPlateau = 256;
   visible_.assign(1, u);  // (the plateau, here)
   int below = -1;         // the triangle the climb came from: lower than the plateau
-  for (std::size_t q = 0; q < visible_.size();) {
+  for (std::size_t q = arrived ? 1 : 0; q < visible_.size();) {
     const int v = visible_[q];
     int higher = -1;
     for (int k = 0; k < 3 && higher < 0; ++k) {
@@ -1951,6 +1958,31 @@ bool SurfaceRepair::insert(int x) {
     s_.across[after][2] = r;
   }
   return true;
+}
+
+// Walks from triangle u to the triangle whose cone from o holds n_x (det(n_a, n_b, n_x) >= 0
+// for each of its edges a -> b), each step across an edge whose determinant is negative.
+// On a convex surface (every edge locally convex, every triangle positive) the cones tile
+// the directions and that triangle's vertex is the highest along n_x (its planes' normals
+// span n_x), found from the normals' orientations alone, without the vertices a climb
+// compares (UV 320 by cube(0.3): 4,372 insertions, 8.5 steps each from a near start). False,
+// with u where it stopped, after kMaxWalk steps.
+bool SurfaceRepair::walk_to_cone(int x, int& u) {
+  constexpr int kMaxWalk = 1 << 16;
+  int from = -1;
+  for (int steps = 0; steps < kMaxWalk; ++steps) {
+    int to = -1;
+    // (The edge tested first turns with each step; the one just crossed is not tested.)
+    for (int j = 0; j < 3 && to < 0; ++j) {
+      const int k = (steps + j) % 3, w = s_.across[u][k];
+      if (w == from) continue;
+      if (det_sign(planes_, precise_, s_.corner[u][k], s_.corner[u][next(k)], x) < 0) to = w;
+    }
+    if (to < 0) return true;
+    from = u;
+    u = to;
+  }
+  return false;
 }
 
 bool SurfaceRepair::run(const std::vector<std::pair<int, int>>& reflex) {
