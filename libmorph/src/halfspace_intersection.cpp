@@ -1512,6 +1512,32 @@ constexpr int kRepairsPerTriangle = 2;
 /// The largest number of neighbours of a plane a repair lifts off its surface.
 constexpr int kMaxLift = 16;
 
+/// Walks from triangle u of s to the triangle whose cone from o holds n_x
+/// (det(n_a, n_b, n_x) >= 0 for each of its edges a -> b), each step across an edge whose
+/// determinant is negative. On a convex surface (every edge locally convex, every triangle
+/// positive) the cones tile the directions and that triangle's vertex is the highest along
+/// n_x (its planes' normals span n_x): found from the normals' orientations alone, without
+/// the vertices a climb compares (UV 320 by cube(0.3): the repair's 4,372 insertions walk
+/// 8.5 steps each from a near start). False, with u where it stopped, after kMaxWalk steps.
+bool walk_to_cone(const DualSurface& s, const std::vector<Plane>& planes,
+                  const PrecisePlanes& precise, int x, int& u) {
+  constexpr int kMaxWalk = 1 << 16;
+  int from = -1;
+  for (int steps = 0; steps < kMaxWalk; ++steps) {
+    int to = -1;
+    // (The edge tested first turns with each step; the one just crossed is not tested.)
+    for (int j = 0; j < 3 && to < 0; ++j) {
+      const int k = (steps + j) % 3, w = s.across[u][k];
+      if (w == from) continue;
+      if (det_sign(planes, precise, s.corner[u][k], s.corner[u][k == 2 ? 0 : k + 1], x) < 0) to = w;
+    }
+    if (to < 0) return true;
+    from = u;
+    u = to;
+  }
+  return false;
+}
+
 /// Repairs a candidate dual surface (closed, oriented, every triangle positively oriented
 /// about o) whose edges `reflex` (triangle, edge) are not locally convex: the far corner d
 /// of the triangle across edge a -> c of triangle (a, c, b) cuts off that triangle's
@@ -1641,7 +1667,6 @@ class SurfaceRepair {
   bool lift(int t, int i);
   bool lift_waiting();
   bool insert(int x);
-  bool walk_to_cone(int x, int& u);
   bool compact();
 
   const std::vector<Plane>& planes_;
@@ -1877,7 +1902,7 @@ bool SurfaceRepair::insert(int x) {
     return compare_exact(planes_[x], hw, hv);
   };
   // The walk's end is the highest vertex: the climb only goes on where it did not arrive.
-  const bool arrived = walk_to_cone(x, u);
+  const bool arrived = walk_to_cone(s_, planes_, precise_, x, u);
   last_ = u;
   constexpr int kMaxPlateau = 256;
   visible_.assign(1, u);  // (the plateau, here)
@@ -1958,31 +1983,6 @@ bool SurfaceRepair::insert(int x) {
     s_.across[after][2] = r;
   }
   return true;
-}
-
-// Walks from triangle u to the triangle whose cone from o holds n_x (det(n_a, n_b, n_x) >= 0
-// for each of its edges a -> b), each step across an edge whose determinant is negative.
-// On a convex surface (every edge locally convex, every triangle positive) the cones tile
-// the directions and that triangle's vertex is the highest along n_x (its planes' normals
-// span n_x), found from the normals' orientations alone, without the vertices a climb
-// compares (UV 320 by cube(0.3): 4,372 insertions, 8.5 steps each from a near start). False,
-// with u where it stopped, after kMaxWalk steps.
-bool SurfaceRepair::walk_to_cone(int x, int& u) {
-  constexpr int kMaxWalk = 1 << 16;
-  int from = -1;
-  for (int steps = 0; steps < kMaxWalk; ++steps) {
-    int to = -1;
-    // (The edge tested first turns with each step; the one just crossed is not tested.)
-    for (int j = 0; j < 3 && to < 0; ++j) {
-      const int k = (steps + j) % 3, w = s_.across[u][k];
-      if (w == from) continue;
-      if (det_sign(planes_, precise_, s_.corner[u][k], s_.corner[u][next(k)], x) < 0) to = w;
-    }
-    if (to < 0) return true;
-    from = u;
-    u = to;
-  }
-  return false;
 }
 
 bool SurfaceRepair::run(const std::vector<std::pair<int, int>>& reflex) {
@@ -2579,19 +2579,31 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
     for (int j = begin; j < end && ok; ++j) {
       const int i = others[j];
       const Plane& p = planes[i];
-      if (!s.near.empty() && s.near[i] >= 0) u = group[s.near[i]];
+      int start = seed[u];  // a triangle of u, where a walk starts
+      if (!s.near.empty() && s.near[i] >= 0) u = group[start = s.near[i]];
       if (!known.empty())
         for (int k = known.begin[others[j]]; k < known.begin[others[j] + 1]; ++k)
           if (vertex_at_point[known.point[k]] >= 0) {
             u = vertex_at_point[known.point[k]];
+            start = seed[u];
             break;
           }
+      // Unless u is known on the plane, the walk to the triangle whose cone holds the normal
+      // (walk_to_cone: the candidate is convex) ends at the highest vertex, and the climb only
+      // goes on where it did not arrive or ends on a known point.
+      bool walked = false;
+      if (!known_through(known, others[j], vertex[u]) &&
+          walk_to_cone(s, planes, precise, i, start)) {
+        u = group[start];
+        walked = true;
+      }
       // With u known on the plane, a neighbour compares with u as it lies to the plane (the
       // cheaper test), and those sides (`sides`, when the climb ends there) start the plateau.
       bool u_on = false;
       for (bool moved = true; moved;) {
         moved = false;
         u_on = known_through(known, others[j], vertex[u]);
+        if (walked && !u_on) break;
         sides.clear();
         for (int a = adj_begin[u]; a < adj_begin[u + 1]; ++a) {
           int s;
