@@ -76,18 +76,12 @@ struct ExactPlane {
 /// at the HalfSpace's normal and offset when its denominator is 1 (the usual case: no Mpzf
 /// copied per plane, where the filters decide nearly everything), else at `scaled`.
 struct Plane {
-  // The exact normal and offset (read through n() and d(): a lazy half-space's are made on
-  // first read, HalfSpace::make_exact).
+  // The exact normal and offset, read through n() and d(): null for a lazy half-space's,
+  // which are made on first read (HalfSpace::make_exact) and read from `source`.
   const V3<ExactN>* n_exact = nullptr;
   const ExactN* d_exact = nullptr;
-  const V3<ExactN>& n() const {
-    if (source) source->make_exact();
-    return *n_exact;
-  }
-  const ExactN& d() const {
-    if (source) source->make_exact();
-    return *d_exact;
-  }
+  const V3<ExactN>& n() const { return n_exact ? *n_exact : source->exact_normal(); }
+  const ExactN& d() const { return d_exact ? *d_exact : source->exact_offset(); }
   std::shared_ptr<const ExactPlane> scaled;
   V3<Interval> ni;
   Interval di;
@@ -175,8 +169,11 @@ std::vector<Plane> planes_of(const std::vector<HalfSpace>& hs) {
       const HalfSpace& h = hs[i];
       const bool unit = h.unit_denominator();
       if (unit) {
-        p.n_exact = h.normal_address();
-        p.d_exact = h.offset_address();
+        // (A lazy half-space's values have no address yet: read from `source`, set below.)
+        if (!h.lazy) {
+          p.n_exact = &h.exact_normal();
+          p.d_exact = &h.exact_offset();
+        }
       } else {
         // (The offset is the numerator: the plane is the HalfSpace times q.)
         const ExactN& q = h.denominator();
@@ -621,8 +618,9 @@ PrecisePlane precise_plane(const Plane& plane) {
   const HalfSpace* h = plane.source;
   // (A lazy half-space has both copies: its exact values are not read here.)
   if (h && !(h->has_normal_dd && h->has_offset_dd)) h->make_exact();
-  precise_scaled({&plane.n_exact->x, &plane.n_exact->y, &plane.n_exact->z, plane.d_exact}, 0, 3,
-                 p.c, h && h->has_normal_dd ? &h->normal_dd : nullptr,
+  const V3<ExactN>* n = plane.n_exact;  // (null, and not read, where both copies are given)
+  precise_scaled({n ? &n->x : nullptr, n ? &n->y : nullptr, n ? &n->z : nullptr, plane.d_exact}, 0,
+                 3, p.c, h && h->has_normal_dd ? &h->normal_dd : nullptr,
                  h && h->has_offset_dd ? &h->offset_dd : nullptr);
   return p;
 }

@@ -48,9 +48,10 @@ struct OnceFlag {
 /// (polytopes with double or dyadic points) have denominator 1; a rational offset p/q is
 /// stored as offset p, denominator q (not necessarily reduced). `source` and `element` are carried
 /// to the facets of the result for their labels.
-/// The exact values (five Mpzf, 440 bytes) are constructed only when set or made: an erosion's
+/// The exact values (five Mpzf, 440 bytes) are allocated only when set or made: an erosion's
 /// thousands of lazy half-spaces, most never read, then cost neither their construction nor
-/// their destruction.
+/// their destruction, nor the memory (a half-space is 184 bytes; with the values inline it
+/// was 624, and an erosion of 327,680 facets spent 6% of its time faulting their pages in).
 struct HalfSpace {
   int source = -1;             // erosion: the facet of A (its label)
   int element = -1;            // erosion: the vertex of B that moved it inwards (its label)
@@ -66,8 +67,8 @@ struct HalfSpace {
  private:
   struct Values;
   bool unit_denominator_ = true;
-  // Set when the storage holds the values (a lazy half-space's in set_exact_from_words,
-  // under `made`; otherwise by the thread that builds the half-space).
+  // Set once the values are allocated (a lazy half-space's in set_exact_from_words, under
+  // `made`; otherwise by the thread that builds the half-space).
   mutable Values* values_ = nullptr;
 
  public:
@@ -134,14 +135,6 @@ struct HalfSpace {
     make_exact();
     return values_ ? values_->offset : zero().offset;
   }
-  /// Where exact_normal() and exact_offset() are, valid to read once make_exact() has run
-  /// (a lazy half-space's storage, before its values are made).
-  const V3<ExactN>* normal_address() const {
-    return values_ || lazy ? &storage()->normal : &zero().normal;
-  }
-  const ExactN* offset_address() const {
-    return values_ || lazy ? &storage()->offset : &zero().offset;
-  }
   /// Whether the exact values are constructed (set, or made from the words).
   bool has_exact_values() const { return values_ != nullptr; }
   /// (erosion.cpp: the words made Mpzf into normal and offset, zero before.)
@@ -161,20 +154,16 @@ struct HalfSpace {
     static const Values value;
     return value;
   }
-  Values* storage() const {
-    return reinterpret_cast<Values*>(const_cast<unsigned char*>(storage_));
-  }
   /// The values, constructed (zero) on first use.
   Values& values() const {
-    if (!values_) values_ = new (storage()) Values;
+    if (!values_) values_ = new Values;
     return *values_;
   }
   void destroy() {
-    if (values_) values_->~Values();
+    delete values_;
     values_ = nullptr;
     unit_denominator_ = true;
   }
-  alignas(Values) unsigned char storage_[sizeof(Values)];
 };
 
 /// Sets h.normal_dd from h.normal = (p1 - p0) x (p2 - p0) for a triangle of double points
