@@ -1647,8 +1647,21 @@ class SurfaceRepair {
     changed_[t] = 1;
     forget(t);
   }
-  /// A slot for one more triangle (an insertion's cone has two more than it replaces).
+  /// Triangle t removed: its slot free for a new one.
+  void kill(int t) {
+    dead_[t] = 1;
+    free_.push_back(t);
+  }
+  /// A slot for one more triangle (an insertion's cone has two more than it replaces): a
+  /// removed triangle's, or a new one. (Growing the surface's arrays would move every vertex
+  /// into new pages: tens of megabytes for one triangle.)
   int new_slot() {
+    if (!free_.empty()) {
+      const int t = free_.back();
+      free_.pop_back();
+      mark_[t] = 0;
+      return t;
+    }
     s_.corner.emplace_back();
     s_.across.emplace_back();
     s_.vertex.emplace_back();
@@ -1677,6 +1690,7 @@ class SurfaceRepair {
   std::vector<int> tested_far_;
   std::vector<signed char> tested_sign_;
   std::vector<Edge> queue_, waiting_;
+  std::vector<int> free_;  // the slots of removed triangles
   // Planes lifted, to insert again, each with a neighbour it had (whose triangles, when it
   // stays on the surface, start the climb: near the lifted dual point however the surface
   // changed since).
@@ -1711,7 +1725,8 @@ bool SurfaceRepair::remove(int t, int i) {
   s_.near[x] = t;  // x's dual point lies beneath t
   make_triangle(t, {y, z, d});
   s_.across[t] = {X, Z, Y};
-  dead_[u] = dead_[w] = 1;
+  kill(u);
+  kill(w);
   push_edges(t);
   return true;
 }
@@ -1830,7 +1845,8 @@ bool SurfaceRepair::lift(int t, int i) {
       s_.across[fan_[r]][e] = to;
     }
   }
-  dead_[fan_[k - 2]] = dead_[fan_[k - 1]] = 1;
+  kill(fan_[k - 2]);
+  kill(fan_[k - 1]);
   s_.near[x] = fan_[0];
   // Where every ear keeps x's plane, x's dual point lies in the cone of one ear (they tile
   // its neighbours' polygon, which winds around it) beneath that ear: inside the dual hull
@@ -1967,7 +1983,7 @@ bool SurfaceRepair::insert(int x) {
       if (ears_[g][0] == ears_[h][0]) return false;  // not a simple cycle
   fan_.clear();
   for (int h = 0; h < nh; ++h) fan_.push_back(h < nv ? visible_[h] : new_slot());
-  for (int h = nh; h < nv; ++h) dead_[visible_[h]] = 1;
+  for (int h = nh; h < nv; ++h) kill(visible_[h]);
   for (int h = 0; h < nh; ++h) make_triangle(fan_[h], ears_[h]);
   for (int h = 0; h < nh; ++h) {
     const int r = fan_[h], a = ears_[h][0], b = ears_[h][1];
