@@ -1518,10 +1518,10 @@ constexpr int kMaxLift = 16;
 /// the vertices a climb compares (UV 320 by cube(0.3): the repair's 4,372 insertions walk
 /// 8.5 steps each from a near start). False, with u where it stopped, after kMaxWalk steps.
 bool walk_to_cone(const DualSurface& s, const std::vector<Plane>& planes,
-                  const PrecisePlanes& precise, int x, int& u) {
+                  const PrecisePlanes& precise, int x, int& u, long& steps_out) {
   constexpr int kMaxWalk = 1 << 16;
   int from = -1;
-  for (int steps = 0; steps < kMaxWalk; ++steps) {
+  for (int steps = 0; steps < kMaxWalk; ++steps, ++steps_out) {
     int to = -1;
     // (The edge tested first turns with each step; the one just crossed is not tested.)
     for (int j = 0; j < 3 && to < 0; ++j) {
@@ -1567,8 +1567,8 @@ bool walk_to_cone(const DualSurface& s, const std::vector<Plane>& planes,
 class SurfaceRepair {
  public:
   SurfaceRepair(const std::vector<Plane>& planes, const PrecisePlanes& precise,
-                const KnownPoints& known, DualSurface& s)
-      : planes_(planes), precise_(precise), known_(known), s_(s) {
+                const KnownPoints& known, DualSurface& s, RepairCounts& counts)
+      : planes_(planes), precise_(precise), known_(known), s_(s), counts_(counts) {
     const int nt = size();
     dead_.assign(nt, 0);
     changed_.assign(nt, 0);
@@ -1684,6 +1684,7 @@ class SurfaceRepair {
   const PrecisePlanes& precise_;
   const KnownPoints& known_;
   DualSurface& s_;
+  RepairCounts& counts_;
   std::vector<char> dead_, changed_;
   // The far-plane signs of the repair's own tests, for the check after it: per slot, the
   // far plane tested (-1: none, or the triangle changed since) and its sign.
@@ -1723,6 +1724,7 @@ bool SurfaceRepair::remove(int t, int i) {
   if (!positive(y, z, d)) return false;
   if (!relink(Z, d, z, t) || !relink(Y, y, d, t)) return false;
   s_.near[x] = t;  // x's dual point lies beneath t
+  ++counts_.removals;
   make_triangle(t, {y, z, d});
   s_.across[t] = {X, Z, Y};
   kill(u);
@@ -1871,6 +1873,7 @@ bool SurfaceRepair::lift_waiting() {
     const bool c_first = around(t, c, kMaxLift, none) < around(t, a, kMaxLift, none);
     const int first = c_first ? next(i) : i, second = c_first ? i : next(i);
     if (lift(t, first) || lift(t, second)) {
+      ++counts_.lifts;
       budget_ -= static_cast<int>(fan_.size());
       lifted = true;
     }
@@ -1887,8 +1890,10 @@ bool SurfaceRepair::lift_waiting() {
 // a cone from x over their boundary; otherwise x stays beneath the surface. False when the
 // surface turns out not convex there (the cone would not close up).
 bool SurfaceRepair::insert(int x) {
+  // (Not the triangles a removed start's stale links lead to: their slots may have been
+  // taken since, anywhere on the surface; 20 steps an insertion against 8 on UV 120 by a
+  // cube.)
   int u = s_.near[x];
-  for (int steps = 0; u >= 0 && dead_[u] && steps < 16; ++steps) u = s_.across[u][0];
   if ((u < 0 || dead_[u]) && last_ >= 0 && !dead_[last_]) u = last_;
   if (u < 0 || dead_[u]) {
     u = 0;
@@ -1916,7 +1921,8 @@ bool SurfaceRepair::insert(int x) {
     return compare_exact(planes_[x], hw, hv);
   };
   // The walk's end is the highest vertex: the climb only goes on where it did not arrive.
-  const bool arrived = walk_to_cone(s_, planes_, precise_, x, u);
+  ++counts_.insertions;
+  const bool arrived = walk_to_cone(s_, planes_, precise_, x, u, counts_.insert_steps);
   last_ = u;
   constexpr int kMaxPlateau = 256;
   visible_.assign(1, u);  // (the plateau, here)
@@ -2057,6 +2063,7 @@ bool SurfaceRepair::run(const std::vector<std::pair<int, int>>& reflex) {
       // planes in an odd order), as in triangulate_polygon.
       record(t, 1, c, -1);
       record(u, 2, a, -1);
+      ++counts_.flips;
       queue_.push_back({t, b, a});
       queue_.push_back({u, c, b});
       queue_.push_back({u, d, c});
@@ -2155,10 +2162,20 @@ bool SurfaceRepair::compact() {
   return kept >= 4;
 }
 
+void add_counts(const IntersectOptions& options, const RepairCounts& c) {
+  if (!options.counts) return;
+  RepairCounts& to = *options.counts;
+  to.flips += c.flips;
+  to.removals += c.removals;
+  to.lifts += c.lifts;
+  to.insertions += c.insertions;
+  to.insert_steps += c.insert_steps;
+}
+
 bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& precise,
                     const KnownPoints& known, DualSurface& s,
-                    const std::vector<std::pair<int, int>>& reflex) {
-  return SurfaceRepair(planes, precise, known, s).run(reflex);
+                    const std::vector<std::pair<int, int>>& reflex, RepairCounts& counts) {
+  return SurfaceRepair(planes, precise, known, s, counts).run(reflex);
 }
 
 /// The check's ray from o: r, with u = e_k x r and w = r x u exactly orthogonal to it, and
@@ -2408,7 +2425,10 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       for (int k = 0; k < 3; ++k)
         if (far_side[3 * t + k] > 0) edges.emplace_back(t, k);
     s.far_side = std::move(far_side);
-    if (!repair_surface(planes, precise, known, s, edges)) return std::nullopt;
+    RepairCounts counts;
+    const bool done = repair_surface(planes, precise, known, s, edges, counts);
+    add_counts(options, counts);
+    if (!done) return std::nullopt;
     *repaired = true;
     return build_verified(hs, planes, precise, known, std::move(s), options, owner, nullptr,
                           &check_ray);
@@ -2585,8 +2605,10 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   // Per plane off the surface that cuts it, where a guess may be repaired: the vertex it
   // cuts off (the climb's end), else -1.
   std::vector<int> cut(can_repair ? others.size() : 0, -1);
+  std::atomic<long> check_steps = 0;
   parallel_chunks(static_cast<int>(others.size()), 64, [&](int begin, int end) {
     RoundingGuard guard;
+    long steps = 0;
     int u = 0;
     std::vector<int> plateau;  // scratch: each list is then allocated once, at its size
     std::vector<signed char> sides;
@@ -2607,7 +2629,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       // goes on where it did not arrive or ends on a known point.
       bool walked = false;
       if (!known_through(known, others[j], vertex[u]) &&
-          walk_to_cone(s, planes, precise, i, start)) {
+          walk_to_cone(s, planes, precise, i, start, steps)) {
         u = group[start];
         walked = true;
       }
@@ -2654,7 +2676,12 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       std::sort(plateau.begin(), plateau.end());
       touched[j].assign(plateau.begin(), plateau.end());
     }
+    check_steps += steps;
   });
+  if (options.counts) {
+    options.counts->check_planes += static_cast<long>(others.size());
+    options.counts->check_steps += check_steps;
+  }
   if (!ok) return std::nullopt;
   if (std::any_of(cut.begin(), cut.end(), [](int v) { return v >= 0; })) {
     // Planes the guess left out that cut it (a closing of a UV sphere, whose result is not
@@ -2680,7 +2707,10 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       s.has_vertex.assign(nt, 0);
     }
     s.far_side = std::move(far_side);
-    if (!SurfaceRepair(planes, precise, known, s).insert_cutting(cutting)) return std::nullopt;
+    RepairCounts counts;
+    const bool done = SurfaceRepair(planes, precise, known, s, counts).insert_cutting(cutting);
+    add_counts(options, counts);
+    if (!done) return std::nullopt;
     *repaired = true;
     return build_verified(hs, planes, precise, known, std::move(s), options, owner, nullptr,
                           &check_ray);

@@ -204,6 +204,18 @@ struct MaybePolytope {
 };
 
 /// Options of intersect_halfspaces.
+/// What the repair of a guess did (IntersectOptions::counts), for tests: deterministic counts
+/// where times are not.
+struct RepairCounts {
+  long flips = 0;
+  long removals = 0;
+  long lifts = 0;
+  long insertions = 0;    // planes put back into a convex surface (lifted, or cutting it)
+  long insert_steps = 0;  // the insertions' walks to their normals' cones, in triangles
+  long check_planes = 0;  // planes off a candidate the check tested
+  long check_steps = 0;   // their walks, in triangles
+};
+
 struct IntersectOptions {
   bool incremental = true;  // false: go straight to the exact hull (tests compare the routes)
   bool polytope = true;     // false: only `rounded` (a final result: no rationals, no Polytope)
@@ -214,6 +226,8 @@ struct IntersectOptions {
   // true: the polytope is built straight from the verified facet cycles (verified_polytope).
   // false: through make_polytope's general build, merge pass and checks (tests compare).
   bool direct_polytope = true;
+  // Not null: the repairs and checks of this intersection add what they did here (tests).
+  RepairCounts* counts = nullptr;
 };
 
 /// Points known to lie exactly on some of the half-spaces' planes: an erosion knows them
