@@ -50,7 +50,7 @@ struct OnceFlag {
 /// to the facets of the result for their labels.
 /// The exact values (five Mpzf, 440 bytes) are allocated only when set or made: an erosion's
 /// thousands of lazy half-spaces, most never read, then cost neither their construction nor
-/// their destruction, nor the memory (a half-space is 184 bytes; with the values inline it
+/// their destruction, nor the memory (a half-space is 176 bytes; with the values inline it
 /// was 624, and an erosion of 327,680 facets spent 6% of its time faulting their pages in).
 struct HalfSpace {
   int source = -1;             // erosion: the facet of A (its label)
@@ -203,7 +203,6 @@ struct MaybePolytope {
   HullRoute route = HullRoute::none;
 };
 
-/// Options of intersect_halfspaces.
 /// What the repair of a guess did (IntersectOptions::counts), for tests: deterministic counts
 /// where times are not.
 struct RepairCounts {
@@ -216,6 +215,7 @@ struct RepairCounts {
   long check_steps = 0;   // their walks, in triangles
 };
 
+/// Options of intersect_halfspaces.
 struct IntersectOptions {
   bool incremental = true;  // false: go straight to the exact hull (tests compare the routes)
   bool polytope = true;     // false: only `rounded` (a final result: no rationals, no Polytope)
