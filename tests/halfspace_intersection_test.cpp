@@ -984,10 +984,17 @@ TEST_CASE("halfspace_intersection: an erosion's repair lifts planes its flips ca
   for (const Case& c : cases) {
     CAPTURE(c.n);
     const Polytope A = make_operand(morph::make_uv_sphere(1.0, c.n), "A");
-    const MaybePolytope r = eroded_three_ways(A, make_operand(c.B, "B"));
+    const Polytope B = make_operand(c.B, "B");
+    const MaybePolytope r = eroded_three_ways(A, B);
     REQUIRE(r.polytope);
     CHECK(r.route == HullRoute::repaired);
     CHECK(r.polytope->num_faces() < A.num_faces());
+    // The repair lifted planes, and put back some that bound the result.
+    RepairCounts counts;
+    CHECK(difference(erode_polytope(A, B, {.counts = &counts}), r) == "");
+    CHECK(counts.lifts > 0);
+    CHECK(counts.insertions > 0);
+    CHECK(counts.cuts > 0);
   }
 }
 

@@ -1951,6 +1951,7 @@ bool SurfaceRepair::insert(int x) {
     s_.near[x] = u;
     return true;
   }
+  ++counts_.cuts;
   // The triangles x cuts off, and the edges around them.
   ++stamp_;
   const unsigned cut = 2 * stamp_, kept = 2 * stamp_ + 1;
@@ -2169,6 +2170,7 @@ void add_counts(const IntersectOptions& options, const RepairCounts& c) {
   to.removals += c.removals;
   to.lifts += c.lifts;
   to.insertions += c.insertions;
+  to.cuts += c.cuts;
   to.insert_steps += c.insert_steps;
 }
 

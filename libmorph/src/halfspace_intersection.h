@@ -210,6 +210,7 @@ struct RepairCounts {
   long removals = 0;
   long lifts = 0;
   long insertions = 0;    // planes put back into a convex surface (lifted, or cutting it)
+  long cuts = 0;          // of those, the ones that cut it (the others stay off)
   long insert_steps = 0;  // the insertions' walks to their normals' cones, in triangles
   long check_planes = 0;  // planes off a candidate the check tested
   long check_steps = 0;   // their walks, in triangles
