@@ -2163,17 +2163,6 @@ bool SurfaceRepair::compact() {
   return kept >= 4;
 }
 
-void add_counts(const IntersectOptions& options, const RepairCounts& c) {
-  if (!options.counts) return;
-  RepairCounts& to = *options.counts;
-  to.flips += c.flips;
-  to.removals += c.removals;
-  to.lifts += c.lifts;
-  to.insertions += c.insertions;
-  to.cuts += c.cuts;
-  to.insert_steps += c.insert_steps;
-}
-
 bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& precise,
                     const KnownPoints& known, DualSurface& s,
                     const std::vector<std::pair<int, int>>& reflex, RepairCounts& counts) {
@@ -2427,10 +2416,10 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       for (int k = 0; k < 3; ++k)
         if (far_side[3 * t + k] > 0) edges.emplace_back(t, k);
     s.far_side = std::move(far_side);
-    RepairCounts counts;
-    const bool done = repair_surface(planes, precise, known, s, edges, counts);
-    add_counts(options, counts);
-    if (!done) return std::nullopt;
+    RepairCounts unused;
+    if (!repair_surface(planes, precise, known, s, edges,
+                        options.counts ? *options.counts : unused))
+      return std::nullopt;
     *repaired = true;
     return build_verified(hs, planes, precise, known, std::move(s), options, owner, nullptr,
                           &check_ray);
@@ -2709,10 +2698,10 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       s.has_vertex.assign(nt, 0);
     }
     s.far_side = std::move(far_side);
-    RepairCounts counts;
-    const bool done = SurfaceRepair(planes, precise, known, s, counts).insert_cutting(cutting);
-    add_counts(options, counts);
-    if (!done) return std::nullopt;
+    RepairCounts unused;
+    if (!SurfaceRepair(planes, precise, known, s, options.counts ? *options.counts : unused)
+             .insert_cutting(cutting))
+      return std::nullopt;
     *repaired = true;
     return build_verified(hs, planes, precise, known, std::move(s), options, owner, nullptr,
                           &check_ray);
