@@ -298,6 +298,20 @@ struct HVertex {
   double MW() const { return Wi.sup(); }
 };
 
+/// The planes' dual points about an interior point o, p = n / (d - <n, o>), in doubles, each
+/// coordinate within `error` of the exact one (negative: no copy): a filter for the tests
+/// of four planes that flips make. The side of plane i at the vertex of planes a, b, c is
+/// the sign of det(p_b - p_i, p_a - p_i, p_c - p_i) (with o at the origin, the plane through
+/// p_a, p_b, p_c is {q : <q, y> = 1} for their vertex y, and det(p_a, p_b, p_c) > 0), and
+/// det(n_a, n_b, n_c) has the sign of det(p_a, p_b, p_c) (each p a positive multiple of its
+/// n). It reads 32 bytes a plane, where the exact tests read a Plane (about 150 bytes) and
+/// make a 208-byte vertex per triangle, most of them dropped again by the next flip.
+struct DualPoint {
+  V3<double> p;
+  double error = -1;
+};
+using DualPoints = std::vector<DualPoint>;  // (one array: one cache line a point)
+
 /// A candidate dual hull: triangles over plane indices, counter-clockwise seen from
 /// outside, and the triangle across each edge (edge k runs from corner k to corner k + 1).
 /// The vertex of a triangle's three planes (vertex_of, in the corners' order) may come
@@ -316,6 +330,9 @@ struct DualSurface {
   // triangles it left, with the same neighbours.
   bool oriented = false;
   std::vector<signed char> far_side;
+  // The planes' dual points about the interior point the candidate was built about, when
+  // it has them: the first filter of the check's and the repair's tests.
+  std::shared_ptr<const DualPoints> dual;
 
   /// The far plane of triangle t's edge k: the corner of the triangle across it that is not
   /// on the edge (-1: none, a degenerate neighbour).
@@ -1191,6 +1208,79 @@ int det_sign(const std::vector<Plane>& planes, const PrecisePlanes& precise, int
   return CGAL::sign(det(pa.n(), pb.n(), pc.n()));
 }
 
+/// The dual points' error bounds (any rounding mode; u = 2^-52 an operation, 2 u an input:
+/// nd and dd are within an ulp of the exact n and d, as for the double filter): e = d - <n, o>
+/// is computed within E = 8 u (|dd| + <|nd|, |o|> + |e|) (two u for dd, seven for the dot
+/// product and its inputs, one for the difference); each coordinate n_j / e is then within
+/// (2 u + u + E / e) of itself relative, taken as 1.25 times that, plus 2^-1073 / e for a
+/// normal component below the subnormal range. A plane gets a copy only when e > 0 with
+/// E <= 2^-20 e and |n|, d and p within [2^-400, 2^400] or 0 (no overflow in the tests;
+/// their underflow is within kDoubleFloor).
+DualPoints dual_points(const std::vector<Plane>& planes, const V3<double>& o) {
+  constexpr double u = 0x1p-52, kLow = 0x1p-400, kHigh = 0x1p400;
+  DualPoints out;
+  const int n = static_cast<int>(planes.size());
+  out.resize(n);
+  parallel_chunks(n, 1024, [&](int begin, int end) {
+    RoundingGuard guard;
+    for (int k = begin; k < end; ++k) {
+      const Plane& q = planes[k];
+      const V3<double> na = q.na();
+      const auto sane = [&](double x) { return x == 0 || (x >= kLow && x <= kHigh); };
+      if (!q.fast || !sane(na.x) || !sane(na.y) || !sane(na.z) || !sane(q.da())) continue;
+      const double m = na.x * std::abs(o.x) + na.y * std::abs(o.y) + na.z * std::abs(o.z);
+      const double e = q.dd - dot(q.nd, o);
+      const double E = 8 * u * (q.da() + m + std::abs(e));
+      if (!(e > 0) || E > 0x1p-20 * e) continue;
+      const V3<double> p{q.nd.x / e, q.nd.y / e, q.nd.z / e};
+      const double big = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+      if (!sane(std::abs(p.x)) || !sane(std::abs(p.y)) || !sane(std::abs(p.z))) continue;
+      out[k] = {p, 1.25 * (2 * u + u + E / e) * big + 0x1p-1073 / e};
+    }
+  });
+  return out;
+}
+
+/// Sign of det(x, y, z) for vectors within dx, dy, dz of the computed x, y, z in every
+/// coordinate, or 2: the evaluation errs by at most 8 u of the permanent (5 operations a
+/// monomial and its sum), the inputs' errors by at most 6 ((X + dx)(Y + dy)(Z + dz) - XYZ)
+/// for X = |x|_inf ..., written without cancellation; half again for second-order terms.
+/// Needs upward rounding (the bound rounds up).
+int det_filter(const V3<double>& x, const V3<double>& y, const V3<double>& z, double dx, double dy,
+               double dz) {
+  const V3<double> yz = cross(y, z);
+  const double value = dot(x, yz);
+  const double X = std::max({std::abs(x.x), std::abs(x.y), std::abs(x.z)});
+  const double Y = std::max({std::abs(y.x), std::abs(y.y), std::abs(y.z)});
+  const double Z = std::max({std::abs(z.x), std::abs(z.y), std::abs(z.z)});
+  const double moved = dx * (Y + dy) * (Z + dz) + X * dy * (Z + dz) + X * Y * dz;
+  const double bound = 1.5 * (6 * 0x1p-49 * X * Y * Z + 6 * moved) + kDoubleFloor;
+  return value > bound ? 1 : value < -bound ? -1 : 2;
+}
+
+/// Sign of det(n_a, n_b, n_c) from the dual points, or 2 (upward rounding).
+int dual_det_sign(const DualPoints& dual, int a, int b, int c) {
+  const DualPoint &x = dual[a], &y = dual[b], &z = dual[c];
+  if (x.error < 0 || y.error < 0 || z.error < 0) return 2;
+  return det_filter(x.p, y.p, z.p, x.error, y.error, z.error);
+}
+
+/// Sign of plane i at the vertex of planes a, b, c (det(n_a, n_b, n_c) > 0) from the dual
+/// points, or 2 (upward rounding). Each difference errs by its points' errors and one
+/// rounding.
+int dual_side(const DualPoints& dual, int a, int b, int c, int i) {
+  constexpr double u = 0x1p-52;
+  const DualPoint &pa = dual[a], &pb = dual[b], &pc = dual[c], &pi = dual[i];
+  const double ea = pa.error, eb = pb.error, ec = pc.error, ei = pi.error;
+  if (ea < 0 || eb < 0 || ec < 0 || ei < 0) return 2;
+  const V3<double>& q = pi.p;
+  const V3<double> x = pb.p - q, y = pa.p - q, z = pc.p - q;
+  const auto norm = [](const V3<double>& w) {
+    return std::max({std::abs(w.x), std::abs(w.y), std::abs(w.z)});
+  };
+  return det_filter(x, y, z, eb + ei + u * norm(x), ea + ei + u * norm(y), ec + ei + u * norm(z));
+}
+
 }  // namespace
 
 // A double within an ulp or two of X / W, moved until X / W lies between the midpoints to
@@ -1518,7 +1608,8 @@ constexpr int kMaxLift = 16;
 /// the vertices a climb compares (UV 320 by cube(0.3): the repair's 4,372 insertions walk
 /// 8.5 steps each from a near start). False, with u where it stopped, after kMaxWalk steps.
 bool walk_to_cone(const DualSurface& s, const std::vector<Plane>& planes,
-                  const PrecisePlanes& precise, int x, int& u, long& steps_out) {
+                  const PrecisePlanes& precise, const DualPoints* dual, int x, int& u,
+                  long& steps_out) {
   constexpr int kMaxWalk = 1 << 16;
   int from = -1;
   for (int steps = 0; steps < kMaxWalk; ++steps, ++steps_out) {
@@ -1527,7 +1618,10 @@ bool walk_to_cone(const DualSurface& s, const std::vector<Plane>& planes,
     for (int j = 0; j < 3 && to < 0; ++j) {
       const int k = (steps + j) % 3, w = s.across[u][k];
       if (w == from) continue;
-      if (det_sign(planes, precise, s.corner[u][k], s.corner[u][k == 2 ? 0 : k + 1], x) < 0) to = w;
+      const int a = s.corner[u][k], b = s.corner[u][k == 2 ? 0 : k + 1];
+      int d = dual ? dual_det_sign(*dual, a, b, x) : 2;
+      if (d == 2) d = det_sign(planes, precise, a, b, x);
+      if (d < 0) to = w;
     }
     if (to < 0) return true;
     from = u;
@@ -1568,7 +1662,12 @@ class SurfaceRepair {
  public:
   SurfaceRepair(const std::vector<Plane>& planes, const PrecisePlanes& precise,
                 const KnownPoints& known, DualSurface& s, RepairCounts& counts)
-      : planes_(planes), precise_(precise), known_(known), s_(s), counts_(counts) {
+      : planes_(planes),
+        precise_(precise),
+        known_(known),
+        s_(s),
+        counts_(counts),
+        dual_(s.dual.get()) {
     const int nt = size();
     dead_.assign(nt, 0);
     changed_.assign(nt, 0);
@@ -1608,9 +1707,27 @@ class SurfaceRepair {
     }
     return s_.vertex[t];
   }
-  bool positive(int a, int b, int c) const { return det_sign(planes_, precise_, a, b, c) > 0; }
+  /// Sign of det(n_a, n_b, n_c): the dual points' filter, then det_sign.
+  int orientation(int a, int b, int c) const {
+    if (dual_) {
+      const int d = dual_det_sign(*dual_, a, b, c);
+      if (decided(d)) return d;
+    }
+    return det_sign(planes_, precise_, a, b, c);
+  }
+  /// Whether the dual points' filter decided a test (d: its sign, or 2), counted.
+  bool decided(int d) const {
+    ++(d != 2 ? counts_.dual_decided : counts_.dual_undecided);
+    return d != 2;
+  }
+  bool positive(int a, int b, int c) const { return orientation(a, b, c) > 0; }
   /// Sign of plane i at the vertex of triangle t.
   int side_at(int i, int t) {
+    if (dual_) {
+      const auto& c = s_.corner[t];
+      const int d = dual_side(*dual_, c[0], c[1], c[2], i);
+      if (decided(d)) return d;
+    }
     HVertex& v = vertex_at(t);
     return known_through(known_, i, v) ? 0 : side(planes_, precise_, i, v);
   }
@@ -1685,6 +1802,7 @@ class SurfaceRepair {
   const KnownPoints& known_;
   DualSurface& s_;
   RepairCounts& counts_;
+  const DualPoints* dual_;  // null when the surface has none
   std::vector<char> dead_, changed_;
   // The far-plane signs of the repair's own tests, for the check after it: per slot, the
   // far plane tested (-1: none, or the triangle changed since) and its sign.
@@ -1702,7 +1820,7 @@ class SurfaceRepair {
   std::vector<int> fan_, link_, outer_, visible_;
   std::vector<char> clipped_, link_joined_;
   std::vector<std::array<int, 3>> ears_;
-  std::vector<HVertex> ear_vertex_;
+  std::vector<std::optional<HVertex>> ear_vertex_;  // computed where a test needed it
   std::vector<std::pair<int, int>> horizon_;
   std::vector<unsigned> mark_;  // per triangle: 2 stamp_ (cut off), 2 stamp_ + 1 (not)
   unsigned stamp_ = 0;
@@ -1786,7 +1904,7 @@ bool SurfaceRepair::lift(int t, int i) {
   for (int left = k; left >= 3; --left) {
     // The first valid ear that keeps x's plane, else the first valid ear.
     int chosen = -1, fallback = -1;
-    HVertex chosen_vertex, fallback_vertex;
+    std::optional<HVertex> chosen_vertex, fallback_vertex;
     for (int b = 0; b < k && chosen < 0; ++b) {
       if (clipped_[b]) continue;
       const int a = prev_left(b), c = next_left(b);
@@ -1796,13 +1914,23 @@ bool SurfaceRepair::lift(int t, int i) {
       bool empty = true;
       for (int j = next_left(c); j != a && empty; j = next_left(j)) {
         const int z = link_[j];
-        empty = det_sign(planes_, precise_, za, zb, z) < 0 ||
-                det_sign(planes_, precise_, zb, zc, z) < 0 ||
-                det_sign(planes_, precise_, zc, za, z) < 0;
+        empty =
+            orientation(za, zb, z) < 0 || orientation(zb, zc, z) < 0 || orientation(zc, za, z) < 0;
       }
       if (!empty) continue;
-      HVertex v = independent_vertex_of(planes_, {za, zb, zc}, known_);
-      if (known_through(known_, x, v) || side(planes_, precise_, x, v) <= 0) {
+      // (The ear's vertex only where the dual points cannot tell x's side: the check
+      // computes it otherwise, once, if the ear lasts.)
+      std::optional<HVertex> v;
+      int sx = 2;
+      if (dual_) {
+        sx = dual_side(*dual_, za, zb, zc, x);
+        decided(sx);
+      }
+      if (sx == 2) {
+        v = independent_vertex_of(planes_, {za, zb, zc}, known_);
+        sx = known_through(known_, x, *v) ? 0 : side(planes_, precise_, x, *v);
+      }
+      if (sx <= 0) {
         chosen = b;
         chosen_vertex = std::move(v);
       } else if (fallback < 0) {
@@ -1827,8 +1955,10 @@ bool SurfaceRepair::lift(int t, int i) {
   const int made = k - 2;
   for (int r = 0; r < made; ++r) {
     make_triangle(fan_[r], ears_[r]);
-    s_.vertex[fan_[r]] = std::move(ear_vertex_[r]);
-    s_.has_vertex[fan_[r]] = 1;
+    if (ear_vertex_[r]) {
+      s_.vertex[fan_[r]] = std::move(*ear_vertex_[r]);
+      s_.has_vertex[fan_[r]] = 1;
+    }
   }
   for (int r = 0; r < made; ++r) {
     for (int e = 0; e < 3; ++e) {
@@ -1922,7 +2052,7 @@ bool SurfaceRepair::insert(int x) {
   };
   // The walk's end is the highest vertex: the climb only goes on where it did not arrive.
   ++counts_.insertions;
-  const bool arrived = walk_to_cone(s_, planes_, precise_, x, u, counts_.insert_steps);
+  const bool arrived = walk_to_cone(s_, planes_, precise_, dual_, x, u, counts_.insert_steps);
   last_ = u;
   constexpr int kMaxPlateau = 256;
   visible_.assign(1, u);  // (the plateau, here)
@@ -2047,14 +2177,16 @@ bool SurfaceRepair::run(const std::vector<std::pair<int, int>>& reflex) {
     if (--budget_ < 0) return false;
     const int X1 = s_.across[t][next(i)], X2 = s_.across[t][prev(i)], Y1 = s_.across[u][next(j)],
               Y2 = s_.across[u][prev(j)];
-    // (A fan too long to follow counts as joined: no flip that could double an edge.)
-    bool joined = b == d;
-    if (!joined && around(t, b, kMaxDegree, [&](int w) { joined = joined || w == d; }) > kMaxDegree)
-      joined = true;
-    bool outer_ok = true;
+    // The new diagonal b -> d is not an edge already: the surface covers the directions
+    // about o once (the check's ray before the repair; flips that keep every triangle
+    // positive keep that), so its triangles project to a spherical triangulation, each edge
+    // a minor arc; with all four triangles positive, the quadrilateral a, d, c, b is convex
+    // there and the arc from b to d runs inside it, where no other edge does. (Following
+    // b's fan to make sure cost a dozen cache misses a flip.)
+    bool outer_ok = b != d;
     for (int o : {X1, X2, Y1, Y2})
       if (o == t || o == u) outer_ok = false;
-    if (!joined && outer_ok && positive(a, d, b) && positive(d, c, b)) {
+    if (outer_ok && positive(a, d, b) && positive(d, c, b)) {
       if (!relink(Y1, d, a, t) || !relink(X1, b, c, u)) return false;
       make_triangle(t, {a, d, b});
       s_.across[t] = {Y1, u, X2};
@@ -2224,7 +2356,9 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       const HVertex& v = s.vertex[t];
       if (v.known < 0 && v.planes == s.corner[t] && w_positive(v)) return true;
     }
-    return det_sign(planes, precise, s.corner[t][0], s.corner[t][1], s.corner[t][2]) > 0;
+    const auto [a, b, c] = s.corner[t];
+    const int d = s.dual ? dual_det_sign(*s.dual, a, b, c) : 2;
+    return (d != 2 ? d : det_sign(planes, precise, a, b, c)) > 0;
   };
   std::atomic<bool> ok = true;
   parallel_chunks(s.oriented ? 0 : nt, 512, [&](int begin, int end) {
@@ -2389,9 +2523,10 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       for (int k = 0; k < 3; ++k) {
         if (far_side[3 * t + k] != 2) continue;
         const int far = s.far_corner(t, k);
-        const int sd = far < 0                        ? 1
-                       : known_through(known, far, v) ? 0
-                                                      : side(planes, precise, far, v);
+        const auto& c = s.corner[t];
+        int sd = far < 0 || !s.dual ? 2 : dual_side(*s.dual, c[0], c[1], c[2], far);
+        if (sd == 2)
+          sd = far < 0 ? 1 : known_through(known, far, v) ? 0 : side(planes, precise, far, v);
         note(sd);
         far_side[3 * t + k] = static_cast<signed char>(sd);
       }
@@ -2620,7 +2755,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
       // goes on where it did not arrive or ends on a known point.
       bool walked = false;
       if (!known_through(known, others[j], vertex[u]) &&
-          walk_to_cone(s, planes, precise, i, start, steps)) {
+          walk_to_cone(s, planes, precise, s.dual.get(), i, start, steps)) {
         u = group[start];
         walked = true;
       }
@@ -3739,9 +3874,11 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
   const PrecisePlanes precise(planes);
   if (options.incremental && options.guess && !expected.empty()) {
     bool repaired = false;
-    if (auto built = build_verified(hs, planes, precise, known,
-                                    expected_surface(planes, precise, known, expected, o_double),
-                                    options, owner, &repaired)) {
+    DualSurface guess = expected_surface(planes, precise, known, expected, o_double);
+    if (options.dual_filter && !guess.corner.empty())
+      guess.dual = std::make_shared<const DualPoints>(dual_points(planes, o_double));
+    if (auto built = build_verified(hs, planes, precise, known, std::move(guess), options, owner,
+                                    &repaired)) {
       built->route = repaired ? HullRoute::repaired : HullRoute::expected;
       return std::move(*built);
     }

@@ -214,6 +214,10 @@ struct RepairCounts {
   long insert_steps = 0;  // the insertions' walks to their normals' cones, in triangles
   long check_planes = 0;  // planes off a candidate the check tested
   long check_steps = 0;   // their walks, in triangles
+  // The repair's orientation and side tests decided by the planes' dual points (a filter
+  // on 32 bytes a plane), and those left to the planes' own filters and exact values.
+  long dual_decided = 0;
+  long dual_undecided = 0;
 };
 
 /// Options of intersect_halfspaces.
@@ -229,6 +233,9 @@ struct IntersectOptions {
   bool direct_polytope = true;
   // Not null: the repairs and checks of this intersection add what they did here (tests).
   RepairCounts* counts = nullptr;
+  // false: the checks and repairs test the planes without their dual points' filter (tests
+  // compare: the same decisions either way).
+  bool dual_filter = true;
 };
 
 /// Points known to lie exactly on some of the half-spaces' planes: an erosion knows them
