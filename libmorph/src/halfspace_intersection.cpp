@@ -2282,7 +2282,7 @@ bool SurfaceRepair::compact() {
     const int r = index[t];
     s_.corner[r] = s_.corner[t];
     s_.across[r] = {index[s_.across[t][0]], index[s_.across[t][1]], index[s_.across[t][2]]};
-    if (r != t) s_.vertex[r] = std::move(s_.vertex[t]);
+    if (r != t && s_.has_vertex[t]) s_.vertex[r] = std::move(s_.vertex[t]);  // (changed: none)
     s_.has_vertex[r] = s_.has_vertex[t];
   }
   s_.corner.resize(kept);
@@ -2783,7 +2783,13 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
           }
         }
       }
-      const int sd = u_on ? 0 : side_of(i, u);
+      // (After a walk, u is the vertex of the triangle it ended on: the dual points first.)
+      int sd = u_on ? 0 : 2;
+      if (sd == 2 && walked && s.dual) {
+        const auto& c = s.corner[start];
+        sd = dual_side(*s.dual, c[0], c[1], c[2], i);
+      }
+      if (sd == 2) sd = side_of(i, u);
       if (sd > 0) {
         if (can_repair)
           cut[j] = u;
