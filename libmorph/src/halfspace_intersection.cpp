@@ -2980,8 +2980,10 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
                                        inverse, rounded[i]))
           continue;
         const HVertex& e = exact_vertex(u);
-        // (Any estimate serves: round_quotient only starts from it.)
-        const double q = v.intervals ? 0 : coordinate(v.Xd(), i) / v.Wd();
+        // (Any estimate serves: round_quotient only starts from it, and gives up for the
+        // rational quotient, a gcd, after four ulps. A vertex with only the double filter's
+        // X and W, within 2^-48 of their magnitudes, starts from the exact values' doubles.)
+        const double q = v.intervals ? 0 : coordinate(*e.X, i).to_double() / e.W->to_double();
         const Interval estimate =
             v.intervals ? coordinate(v.Xi, i) / v.Wi : Interval(std::isfinite(q) ? q : 0.0);
         rounded[i] = round_quotient(coordinate(*e.X, i), *e.W, estimate);
