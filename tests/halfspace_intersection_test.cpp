@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "fims.h"
+#include "huge_pages.h"
 #include "support/polytopes.h"
 
 namespace {
@@ -1023,6 +1024,31 @@ TEST_CASE("halfspace_intersection: planes put back walk a few triangles to their
   CAPTURE(counts.check_planes);
   CAPTURE(counts.check_steps);
   CHECK(counts.check_steps < 16 * counts.check_planes);
+}
+
+// The allocator of the largest arrays (huge_pages.h): blocks from operator new below
+// kHugeBlock, mapped with huge-page advice above it; a vector growing across the threshold
+// keeps its values, and copies, moves and shrinks free what they should (the sanitizer
+// build checks the frees).
+TEST_CASE("halfspace_intersection: the huge-page allocator holds what it is given") {
+  using Vector = std::vector<std::uint64_t, morph::detail::HugePageAllocator<std::uint64_t>>;
+  const std::size_t n = 3 * morph::detail::kHugeBlock / sizeof(std::uint64_t);
+  Vector v;
+  for (std::size_t i = 0; i < n; ++i) v.push_back(i * 2654435761u);
+  REQUIRE(v.size() == n);
+  CHECK(v.capacity() * sizeof(std::uint64_t) >= morph::detail::kHugeBlock);
+  Vector copy = v;
+  bool same = true;
+  for (std::size_t i = 0; i < n; ++i) same = same && copy[i] == i * 2654435761u;
+  CHECK(same);
+  Vector moved = std::move(copy);
+  CHECK(moved.size() == n);
+  moved.resize(16);
+  moved.shrink_to_fit();
+  CHECK(moved.size() == 16);
+  CHECK(moved[15] == std::uint64_t{15} * 2654435761u);
+  Vector small(100, 7);
+  CHECK(small[99] == 7);
 }
 
 // The repair's and the check's first filter, on the planes' dual points (32 bytes a plane),

@@ -43,6 +43,7 @@
 
 #include "fims.h"
 #include "gauss_map.h"
+#include "huge_pages.h"
 #include "parallel.h"
 
 namespace morph::detail {
@@ -98,6 +99,8 @@ struct Plane {
   V3<double> na() const { return {std::abs(nd.x), std::abs(nd.y), std::abs(nd.z)}; }
   double da() const { return std::abs(dd); }
 };
+/// A plane per half-space, made afresh for each intersection (huge_pages.h).
+using Planes = std::vector<Plane, HugePageAllocator<Plane>>;
 
 // The double filter. A vertex's X and W (Cramer's rule, meet_of_crosses) are evaluated in
 // doubles from the planes' doubles, each coordinate with its magnitude M: the same
@@ -160,8 +163,8 @@ Interval neighbours_interval(const DD& c) {
   return c.hi > 0 ? Interval(toward, away) : Interval(away, toward);
 }
 
-std::vector<Plane> planes_of(const std::vector<HalfSpace>& hs) {
-  std::vector<Plane> planes(hs.size());
+Planes planes_of(const std::vector<HalfSpace>& hs) {
+  Planes planes(hs.size());
   parallel_chunks(static_cast<int>(hs.size()), 256, [&](int begin, int end) {
     RoundingGuard guard;
     for (int i = begin; i < end; ++i) {
@@ -232,7 +235,7 @@ CentreResult exact_centre(const std::vector<HalfSpace>& hs) {
 }
 
 /// o strictly inside every half-space? (interval filter, exact when undecided)
-bool strictly_inside(const std::vector<Plane>& planes, const V3<double>& o) {
+bool strictly_inside(const Planes& planes, const V3<double>& o) {
   const V3<Interval> oi = to_interval(o);
   std::atomic<bool> inside = true;
   parallel_chunks(static_cast<int>(planes.size()), 512, [&](int begin, int end) {
@@ -297,6 +300,8 @@ struct HVertex {
   double Wd() const { return Wi.inf(); }
   double MW() const { return Wi.sup(); }
 };
+/// Vertices by the hundred thousand, made afresh for each intersection (huge_pages.h).
+using HVertices = std::vector<HVertex, HugePageAllocator<HVertex>>;
 
 /// The planes' dual points about an interior point o, p = n / (d - <n, o>), in doubles, each
 /// coordinate within `error` of the exact one (negative: no copy): a filter for the tests
@@ -319,7 +324,7 @@ using DualPoints = std::vector<DualPoint>;  // (one array: one cache line a poin
 struct DualSurface {
   std::vector<std::array<int, 3>> corner;
   std::vector<std::array<int, 3>> across;
-  std::vector<HVertex> vertex;  // empty, or one per triangle
+  HVertices vertex;  // empty, or one per triangle
   std::vector<char> has_vertex;
   // Empty, or per plane: a triangle near the plane's dual point, for one that is not on the
   // surface (removed by a repair), where the check's climb starts; -1 where none is known.
@@ -386,8 +391,8 @@ void meet(const V3<T>& na, const T& da, const V3<T>& nb, const T& db, const V3<T
 }
 
 /// The interval meet of a vertex's three planes, X and W (needs a RoundingGuard).
-void interval_meet(const std::vector<Plane>& planes, const std::array<int, 3>& abc,
-                   V3<Interval>& Xi, Interval& Wi) {
+void interval_meet(const Planes& planes, const std::array<int, 3>& abc, V3<Interval>& Xi,
+                   Interval& Wi) {
   const Plane &a = planes[abc[0]], &b = planes[abc[1]], &c = planes[abc[2]];
   meet(a.ni, a.di, b.ni, b.di, c.ni, c.di, Xi, Wi);
 }
@@ -398,7 +403,7 @@ V3<Interval> quotient(const V3<Interval>& Xi, const Interval& Wi) {
   return {Xi.x / Wi, Xi.y / Wi, Xi.z / Wi};
 }
 /// Gives v its intervals, when it has only doubles (needs a RoundingGuard).
-void make_intervals(const std::vector<Plane>& planes, HVertex& v) {
+void make_intervals(const Planes& planes, HVertex& v) {
   if (v.intervals) return;
   interval_meet(planes, v.planes, v.Xi, v.Wi);
   v.intervals = true;
@@ -424,7 +429,7 @@ void double_meet(const Plane& a, const Plane& b, const Plane& c, const V3<double
 
 /// The vertex of three planes: the double filter's when they are all fast, else intervals
 /// (needs a RoundingGuard).
-HVertex vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& abc) {
+HVertex vertex_of(const Planes& planes, const std::array<int, 3>& abc) {
   HVertex v;
   v.planes = abc;
   const Plane &a = planes[abc[0]], &b = planes[abc[1]], &c = planes[abc[2]];
@@ -442,7 +447,7 @@ HVertex vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& ab
 /// An enclosure of X / W (needs a RoundingGuard): the vertex's Xi / Wi, or, for a vertex with
 /// only doubles, X and W widened by kMeetError of their magnitudes when W > 0 is certain
 /// (fewer operations than the interval meet), else the interval meet.
-V3<Interval> enclosure_of(const std::vector<Plane>& planes, const HVertex& v);
+V3<Interval> enclosure_of(const Planes& planes, const HVertex& v);
 
 /// Whether W > 0 is certain from the vertex's filter (false: undecided or not positive).
 bool w_positive(const HVertex& v) {
@@ -450,7 +455,7 @@ bool w_positive(const HVertex& v) {
   return v.fast && v.Wd() > kMeetError * v.MW() + kDoubleFloor;
 }
 
-V3<Interval> enclosure_of(const std::vector<Plane>& planes, const HVertex& v) {
+V3<Interval> enclosure_of(const Planes& planes, const HVertex& v) {
   if (v.intervals) return quotient(v.Xi, v.Wi);
   if (!w_positive(v)) {
     V3<Interval> Xi;
@@ -486,8 +491,7 @@ void take_known(const KnownPoints& known, HVertex& v) {
   if (k >= 0) set_known(known, k, v);
 }
 /// The vertex of three planes, from a known point where there is one (take_known).
-HVertex vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& abc,
-                  const KnownPoints& known) {
+HVertex vertex_of(const Planes& planes, const std::array<int, 3>& abc, const KnownPoints& known) {
   HVertex v = vertex_of(planes, abc);
   take_known(known, v);
   return v;
@@ -496,7 +500,7 @@ HVertex vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& ab
 /// The vertex of three planes whose normals are known to be independent (det > 0, checked
 /// exactly): a known point on all three is taken as it is, without the meet's intervals
 /// (vertex_of needs those only to tell the normals independent).
-HVertex independent_vertex_of(const std::vector<Plane>& planes, const std::array<int, 3>& abc,
+HVertex independent_vertex_of(const Planes& planes, const std::array<int, 3>& abc,
                               const KnownPoints& known) {
   const int k = known.empty() ? -1 : known.common(abc[0], abc[1], abc[2]);
   if (k < 0) return vertex_of(planes, abc, known);
@@ -519,7 +523,7 @@ void set_exact(HVertex& v, V3<ExactN> X, ExactN W) {
 }
 
 /// Computes the exact coordinates of a vertex, once.
-void make_exact(const std::vector<Plane>& planes, HVertex& v) {
+void make_exact(const Planes& planes, HVertex& v) {
   if (v.X) return;
   const Plane &a = planes[v.planes[0]], &b = planes[v.planes[1]], &c = planes[v.planes[2]];
   v.made = std::make_unique<ExactCoordinates>();
@@ -805,7 +809,7 @@ class PrecisePlanes {
   /// The copies of planes with both double-double copies (HalfSpace::normal_dd, offset_dd)
   /// are made here, in order: a few operations on values read by then, where made on first
   /// use they cost a cache miss on the half-space each (scattered, and large).
-  explicit PrecisePlanes(const std::vector<Plane>& planes)
+  explicit PrecisePlanes(const Planes& planes)
       : planes_(planes), precise_(planes.size()), once_(planes.size()) {
     parallel_chunks(static_cast<int>(planes.size()), 512, [&](int begin, int end) {
       RoundingGuard nearest(CGAL_FE_TONEAREST);
@@ -839,7 +843,7 @@ class PrecisePlanes {
   static constexpr int kAhead = 4;
 
  private:
-  const std::vector<Plane>& planes_;
+  const Planes& planes_;
   mutable std::vector<PrecisePlane> precise_;  // each written once, under its flag in once_
   OnceFlags once_;
 };
@@ -956,7 +960,7 @@ int double_compare(const Plane& p, const HVertex& u, const HVertex& v) {
 
 /// The interval sign of <n, X> - d W, from v's intervals or, where it has none, ones made
 /// here (not kept: v may be shared between threads).
-int interval_side(const std::vector<Plane>& planes, const Plane& p, const HVertex& v) {
+int interval_side(const Planes& planes, const Plane& p, const HVertex& v) {
   if (v.intervals) return interval_sign(dot(p.ni, v.Xi) - p.di * v.Wi);
   V3<Interval> Xi;
   Interval Wi;
@@ -969,8 +973,7 @@ int interval_side(const std::vector<Plane>& planes, const Plane& p, const HVerte
 /// half-space. A known point skips the precise stage: its exact coordinates are there, and
 /// small (in a closing the undecided tests are mostly exact zeros, planes touching the
 /// result).
-int side_filter(const std::vector<Plane>& planes, const PrecisePlanes& precise, int i,
-                const HVertex& v) {
+int side_filter(const Planes& planes, const PrecisePlanes& precise, int i, const HVertex& v) {
   const Plane& p = planes[i];
   const int s = double_side(p, v);
   if (s != 2) return s;
@@ -999,7 +1002,7 @@ int side_exact(const Plane& p, const HVertex& v) {
 /// side_filter), then intervals, then exact coordinates (computed once). Planes nearly through one
 /// point (the moved facets around a vertex of a nearly planar A) leave most of these tests to the
 /// precise stage.
-int side(const std::vector<Plane>& planes, const PrecisePlanes& precise, int i, HVertex& v) {
+int side(const Planes& planes, const PrecisePlanes& precise, int i, HVertex& v) {
   const Plane& p = planes[i];
   int s = double_side(p, v);
   if (s != 2) return s;
@@ -1024,8 +1027,8 @@ int side(const std::vector<Plane>& planes, const PrecisePlanes& precise, int i, 
 
 /// Sign of <n, u> - <n, v> from the filters alone (doubles, precise, intervals), or 2 (two
 /// known points skip the precise stage, as in side_filter).
-int compare_filter(const std::vector<Plane>& planes, const PrecisePlanes& precise, int i,
-                   const HVertex& u, const HVertex& v) {
+int compare_filter(const Planes& planes, const PrecisePlanes& precise, int i, const HVertex& u,
+                   const HVertex& v) {
   const Plane& p = planes[i];
   const int s = double_compare(p, u, v);
   if (s != 2) return s;
@@ -1062,7 +1065,7 @@ int compare_exact(const Plane& p, const HVertex& u, const HVertex& v) {
 /// at most once; they do not depend on the thread, so neither does any decision).
 class LazyExact {
  public:
-  LazyExact(const std::vector<Plane>& planes, std::vector<HVertex>& vertex)
+  LazyExact(const Planes& planes, HVertices& vertex)
       : planes_(planes), vertex_(vertex), once_(vertex.size()) {}
   const HVertex& operator()(int v) {
     once_.call(v, [&] { make_exact(planes_, vertex_[v]); });
@@ -1070,8 +1073,8 @@ class LazyExact {
   }
 
  private:
-  const std::vector<Plane>& planes_;
-  std::vector<HVertex>& vertex_;
+  const Planes& planes_;
+  HVertices& vertex_;
   OnceFlags once_;
 };
 
@@ -1193,7 +1196,7 @@ int double_det_sign(const Plane& a, const Plane& b, const Plane& c) {
 /// then Mpzf. The double filter costs a few dozen instructions where the interval
 /// determinant costs a few hundred (uvsphere_1600 erosion, the repair's and the check's
 /// orientation tests: 0.77M to 0.45M instructions).
-int det_sign(const std::vector<Plane>& planes, const PrecisePlanes& precise, int a, int b, int c) {
+int det_sign(const Planes& planes, const PrecisePlanes& precise, int a, int b, int c) {
   const Plane &pa = planes[a], &pb = planes[b], &pc = planes[c];
   const int d = double_det_sign(pa, pb, pc);
   if (d != 2) return d;
@@ -1216,7 +1219,7 @@ int det_sign(const std::vector<Plane>& planes, const PrecisePlanes& precise, int
 /// normal component below the subnormal range. A plane gets a copy only when e > 0 with
 /// E <= 2^-20 e and |n|, d and p within [2^-400, 2^400] or 0 (no overflow in the tests;
 /// their underflow is within kDoubleFloor).
-DualPoints dual_points(const std::vector<Plane>& planes, const V3<double>& o) {
+DualPoints dual_points(const Planes& planes, const V3<double>& o) {
   constexpr double u = 0x1p-52, kLow = 0x1p-400, kHigh = 0x1p400;
   DualPoints out;
   const int n = static_cast<int>(planes.size());
@@ -1334,8 +1337,8 @@ namespace {
 
 /// Whether the facet cycle `cyc` runs clockwise about `normal` (interval Newell normal of
 /// the vertices, rationals when that cannot decide).
-bool clockwise(const std::vector<int>& cyc, const std::vector<HVertex>& vertex,
-               const V3<ExactN>& normal, LazyExact& exact_vertex) {
+bool clockwise(const std::vector<int>& cyc, const HVertices& vertex, const V3<ExactN>& normal,
+               LazyExact& exact_vertex) {
   const int n = static_cast<int>(cyc.size());
   {
     RoundingGuard guard;
@@ -1366,9 +1369,9 @@ class VertexExactPoints final : public LazyExactPoints {
   /// that `planes` and the vertices point at, unless `owner` keeps them (intersect_halfspaces):
   /// without it, the planes of the vertices still without exact coordinates are copied with
   /// their exact values (the others are never read), and so are the known points.
-  VertexExactPoints(const std::vector<Plane>& planes, std::vector<HVertex> vertex,
-                    std::vector<int> order, std::shared_ptr<const void> owner)
-      : planes_(owner ? planes : std::vector<Plane>(planes.size())),
+  VertexExactPoints(const Planes& planes, HVertices vertex, std::vector<int> order,
+                    std::shared_ptr<const void> owner)
+      : planes_(owner ? planes : Planes(planes.size())),
         vertex_(std::move(vertex)),
         order_(std::move(order)),
         once_(order_.size()),
@@ -1400,8 +1403,8 @@ class VertexExactPoints final : public LazyExactPoints {
   }
 
  private:
-  std::vector<Plane> planes_;
-  mutable std::vector<HVertex> vertex_;  // each written once, under its flag in once_
+  Planes planes_;
+  mutable HVertices vertex_;  // each written once, under its flag in once_
   std::vector<int> order_;
   OnceFlags once_;
   std::shared_ptr<const void> owner_;  // of what planes_ and vertex_ point at, or null
@@ -1411,9 +1414,8 @@ class VertexExactPoints final : public LazyExactPoints {
 /// (`vertex` is moved away): computed on demand (VertexExactPoints), with the precise
 /// coordinates, or, when `eager`, all computed now and without precise coordinates (the
 /// route before, which tests compare with).
-ExactPoints polytope_points(const std::vector<Plane>& planes, std::vector<HVertex>& vertex,
-                            const std::vector<int>& order, bool eager,
-                            std::shared_ptr<const void> owner) {
+ExactPoints polytope_points(const Planes& planes, HVertices& vertex, const std::vector<int>& order,
+                            bool eager, std::shared_ptr<const void> owner) {
   const int nv = static_cast<int>(order.size());
   ExactPoints exact;
   if (eager) {
@@ -1607,9 +1609,8 @@ constexpr int kMaxLift = 16;
 /// n_x (its planes' normals span n_x): found from the normals' orientations alone, without
 /// the vertices a climb compares (UV 320 by cube(0.3): the repair's 4,372 insertions walk
 /// 8.5 steps each from a near start). False, with u where it stopped, after kMaxWalk steps.
-bool walk_to_cone(const DualSurface& s, const std::vector<Plane>& planes,
-                  const PrecisePlanes& precise, const DualPoints* dual, int x, int& u,
-                  long& steps_out) {
+bool walk_to_cone(const DualSurface& s, const Planes& planes, const PrecisePlanes& precise,
+                  const DualPoints* dual, int x, int& u, long& steps_out) {
   constexpr int kMaxWalk = 1 << 16;
   int from = -1;
   for (int steps = 0; steps < kMaxWalk; ++steps, ++steps_out) {
@@ -1660,8 +1661,8 @@ bool walk_to_cone(const DualSurface& s, const std::vector<Plane>& planes,
 /// Triangles removed are dropped from `s`; triangles changed have no vertex (has_vertex).
 class SurfaceRepair {
  public:
-  SurfaceRepair(const std::vector<Plane>& planes, const PrecisePlanes& precise,
-                const KnownPoints& known, DualSurface& s, RepairCounts& counts)
+  SurfaceRepair(const Planes& planes, const PrecisePlanes& precise, const KnownPoints& known,
+                DualSurface& s, RepairCounts& counts)
       : planes_(planes),
         precise_(precise),
         known_(known),
@@ -1797,7 +1798,7 @@ class SurfaceRepair {
   bool insert(int x);
   bool compact();
 
-  const std::vector<Plane>& planes_;
+  const Planes& planes_;
   const PrecisePlanes& precise_;
   const KnownPoints& known_;
   DualSurface& s_;
@@ -2295,9 +2296,9 @@ bool SurfaceRepair::compact() {
   return kept >= 4;
 }
 
-bool repair_surface(const std::vector<Plane>& planes, const PrecisePlanes& precise,
-                    const KnownPoints& known, DualSurface& s,
-                    const std::vector<std::pair<int, int>>& reflex, RepairCounts& counts) {
+bool repair_surface(const Planes& planes, const PrecisePlanes& precise, const KnownPoints& known,
+                    DualSurface& s, const std::vector<std::pair<int, int>>& reflex,
+                    RepairCounts& counts) {
   return SurfaceRepair(planes, precise, known, s, counts).run(reflex);
 }
 
@@ -2336,8 +2337,7 @@ int away_sign(const Plane& p, const V3<double>& gc, const V3<double>& d) {
 /// `repaired`, when not null (a guess, with its triangles' vertices), allows edges that are
 /// not locally convex to be repaired (repair_surface) and the result checked again; it
 /// tells whether that happened. `given_ray`: the ray of the check before a repair.
-std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
-                                            const std::vector<Plane>& planes,
+std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs, const Planes& planes,
                                             const PrecisePlanes& precise, const KnownPoints& known,
                                             DualSurface s, const IntersectOptions& options,
                                             const std::shared_ptr<const void>& owner,
@@ -2597,7 +2597,7 @@ std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs,
   // Each group's vertex is its seed's, moved in place to index g (seed[g] >= g, and seeds
   // increase: a source is never an earlier destination); none moves when every group is a
   // single triangle.
-  std::vector<HVertex> vertex;
+  HVertices vertex;
   if (stored) {
     if (!simple)
       for (int g = 0; g < nv; ++g)
@@ -3037,8 +3037,8 @@ class IncrementalHull {
  public:
   enum class Outcome { hull, too_small, failed };
 
-  IncrementalHull(const std::vector<Plane>& planes, const PrecisePlanes& precise,
-                  const KnownPoints& known, const V3<double>& o, double reach)
+  IncrementalHull(const Planes& planes, const PrecisePlanes& precise, const KnownPoints& known,
+                  const V3<double>& o, double reach)
       : planes_(planes), precise_(precise), known_(known), n_(static_cast<int>(planes.size())) {
     const double dirs[4][3] = {{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}};
     for (int k = 0; k < 4; ++k) {
@@ -3311,7 +3311,7 @@ class IncrementalHull {
     return true;
   }
 
-  const std::vector<Plane>& planes_;
+  const Planes& planes_;
   const PrecisePlanes& precise_;
   const KnownPoints& known_;
   int n_;
@@ -3329,7 +3329,7 @@ class IncrementalHull {
 
 /// A power of two that the distance (L1) from o to the intersection's vertices most likely
 /// stays below: a few times the largest distance from o to a plane (the run checks it).
-double first_reach(const std::vector<Plane>& planes, const V3<double>& o) {
+double first_reach(const Planes& planes, const V3<double>& o) {
   double r = 0;
   for (const Plane& p : planes) {
     const V3<double> n{p.n().x.to_double(), p.n().y.to_double(), p.n().z.to_double()};
@@ -3341,7 +3341,7 @@ double first_reach(const std::vector<Plane>& planes, const V3<double>& o) {
 
 /// The dual hull of the exact dual points about o: n / (d - <n, o>), with o = p / q
 /// (q an integer) written as q n / (q d - <n, p>).
-DualSurface exact_dual_hull(const std::vector<Plane>& planes, const V3<Exact>& o) {
+DualSurface exact_dual_hull(const Planes& planes, const V3<Exact>& o) {
   using Point = ExactKernel::Point_3;
   using FT = ExactKernel::FT;
   using Q = CGAL::Quotient<ExactN>;
@@ -3388,7 +3388,7 @@ void probe_rounding(const HVertex& v, PreciseProbe& out) {
 }  // namespace
 
 PreciseProbe probe_precise(const std::vector<HalfSpace>& hs) {
-  const std::vector<Plane> planes = planes_of(hs);
+  const Planes planes = planes_of(hs);
   RoundingGuard nearest(CGAL_FE_TONEAREST);
   const PrecisePlanes precise(planes);
   PreciseProbe out;
@@ -3410,7 +3410,7 @@ PreciseProbe probe_precise(const std::vector<HalfSpace>& hs) {
 }
 
 DoubleProbe probe_double(const std::vector<HalfSpace>& hs) {
-  const std::vector<Plane> planes = planes_of(hs);
+  const Planes planes = planes_of(hs);
   RoundingGuard guard;  // (vertex_of's intervals for planes that are not fast)
   DoubleProbe out;
   const HVertex u = vertex_of(planes, {0, 1, 2});
@@ -3429,7 +3429,7 @@ PreciseProbe probe_precise_point(const V3<ExactN>& X, const ExactN& W) {
   v.known = 0;
   v.X = &X;
   v.W = &W;
-  const std::vector<Plane> none;
+  const Planes none;
   make_precise(PrecisePlanes(none), v);
   probe_rounding(v, out);
   return out;
@@ -3543,7 +3543,7 @@ constexpr int kFlipsPerCorner = 4;
 /// planes in an odd order: the opposite sign, and it was positive); 0 for planes through
 /// one known point (four planes through a point).
 /// Needs a RoundingGuard.
-bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& precise,
+bool triangulate_polygon(const Planes& planes, const PrecisePlanes& precise,
                          const KnownPoints& known, const V3<double>& o, const int* p, int k,
                          bool split, std::array<int, 3>* out, HVertex* out_vertex, char* out_has,
                          signed char* out_far, PolygonScratch& scratch) {
@@ -3762,7 +3762,7 @@ bool triangulate_polygon(const std::vector<Plane>& planes, const PrecisePlanes& 
 /// triangulated (triangulate_polygon, in parallel; counter-clockwise seen from outside, as
 /// the dual hull's), joined across shared edges. Empty when a polygon cannot be
 /// triangulated or the triangles do not close up into a surface.
-DualSurface expected_surface(const std::vector<Plane>& planes, const PrecisePlanes& precise,
+DualSurface expected_surface(const Planes& planes, const PrecisePlanes& precise,
                              const KnownPoints& known, const ExpectedVertices& expected,
                              const V3<double>& o) {
   DualSurface s;
@@ -3857,7 +3857,7 @@ MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<do
                                    const ExpectedVertices& expected,
                                    std::shared_ptr<const void> owner) {
   MaybePolytope out;
-  const std::vector<Plane> planes = planes_of(hs);
+  const Planes planes = planes_of(hs);
   V3<Exact> o = to_exact(hint);
   V3<double> o_double = hint;
   if (!strictly_inside(planes, hint)) {
