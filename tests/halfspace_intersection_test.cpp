@@ -43,8 +43,8 @@ HalfSpace plane(double nx, double ny, double nz, const Exact& offset, int source
 }
 
 /// The six planes of the cube [-r, r]^3.
-std::vector<HalfSpace> cube_planes(double r) {
-  std::vector<HalfSpace> hs;
+HalfSpaces cube_planes(double r) {
+  HalfSpaces hs;
   const double axes[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
   for (const auto& a : axes)
     hs.push_back(plane(a[0], a[1], a[2], Exact(r), static_cast<int>(hs.size())));
@@ -58,9 +58,9 @@ V3<Exact> rational_apex() {
 
 /// The cube [-2, 2]^3 and k planes tilted around the z axis, all exactly through
 /// rational_apex() (a cone's apex).
-std::vector<HalfSpace> planes_through_apex(int k) {
+HalfSpaces planes_through_apex(int k) {
   const V3<Exact> apex = rational_apex();
-  std::vector<HalfSpace> hs = cube_planes(2.0);
+  HalfSpaces hs = cube_planes(2.0);
   for (int i = 0; i < k; ++i) {
     const double t = 2 * M_PI * i / k;
     const V3<double> n{std::cos(t), std::sin(t), 0.75};
@@ -104,7 +104,7 @@ bool rounded_from_exact(const MaybePolytope& r) {
 
 /// The intersection by the default (incremental) route, checked against the exact route;
 /// the rounded-only result is the same.
-MaybePolytope checked(const std::vector<HalfSpace>& hs, const V3<double>& hint = {0, 0, 0}) {
+MaybePolytope checked(const HalfSpaces& hs, const V3<double>& hint = {0, 0, 0}) {
   MaybePolytope fast = intersect_halfspaces(hs, hint);
   const MaybePolytope exact = intersect_halfspaces(hs, hint, {.incremental = false});
   const MaybePolytope rounded = intersect_halfspaces(hs, hint, {.polytope = false});
@@ -206,7 +206,7 @@ TEST_CASE("halfspace_intersection: a cube is found by the incremental hull") {
 // the hull, so a hull in doubles would miss the facet (6 facets). The incremental hull
 // decides it exactly, without a fallback.
 TEST_CASE("halfspace_intersection: a cut below double resolution is found exactly") {
-  std::vector<HalfSpace> hs = cube_planes(1.0);
+  HalfSpaces hs = cube_planes(1.0);
   hs.push_back(plane(1, 1, 1, Exact(3) - Exact(std::ldexp(1.0, -60)), 6));
   const MaybePolytope r = checked(hs);
   REQUIRE(r.polytope);
@@ -219,7 +219,7 @@ TEST_CASE("halfspace_intersection: a cut below double resolution is found exactl
 // a square pyramid whose apex has degree 4.
 TEST_CASE("halfspace_intersection: planes through one vertex are grouped exactly") {
   for (const Exact offset : {Exact(1), Exact(1) / Exact(3)}) {
-    std::vector<HalfSpace> hs;
+    HalfSpaces hs;
     for (int s = 0; s < 8; ++s)
       hs.push_back(plane(s & 1 ? -1 : 1, s & 2 ? -1 : 1, s & 4 ? -1 : 1, offset, s));
     const MaybePolytope r = checked(hs);
@@ -227,9 +227,9 @@ TEST_CASE("halfspace_intersection: planes through one vertex are grouped exactly
     CHECK(r.polytope->num_faces() == 8);
     CHECK(r.polytope->num_vertices() == 6);
   }
-  std::vector<HalfSpace> pyramid = {plane(0, 0, -1, Exact(1), 0), plane(1, 0, 1, Exact(1), 1),
-                                    plane(-1, 0, 1, Exact(1), 2), plane(0, 1, 1, Exact(1), 3),
-                                    plane(0, -1, 1, Exact(1), 4)};
+  HalfSpaces pyramid = {plane(0, 0, -1, Exact(1), 0), plane(1, 0, 1, Exact(1), 1),
+                        plane(-1, 0, 1, Exact(1), 2), plane(0, 1, 1, Exact(1), 3),
+                        plane(0, -1, 1, Exact(1), 4)};
   const MaybePolytope r = checked(pyramid);
   REQUIRE(r.polytope);
   CHECK(r.polytope->num_faces() == 5);
@@ -241,7 +241,7 @@ TEST_CASE("halfspace_intersection: planes through one vertex are grouped exactly
 TEST_CASE("halfspace_intersection: many planes through a rational apex") {
   const V3<Exact> apex = rational_apex();
   for (int k : {5, 12, 40}) {
-    const std::vector<HalfSpace> hs = planes_through_apex(k);
+    const HalfSpaces hs = planes_through_apex(k);
     const MaybePolytope r = checked(hs);
     REQUIRE(r.polytope);
     int found = 0;
@@ -259,7 +259,7 @@ TEST_CASE("halfspace_intersection: many planes through a rational apex") {
 // agree with the exact route, without a fallback.
 TEST_CASE("halfspace_intersection: nearly coincident planes") {
   for (int seed = 0; seed < 12; ++seed) {
-    std::vector<HalfSpace> hs = cube_planes(2.0);
+    HalfSpaces hs = cube_planes(2.0);
     hs[4] = plane(0, 0, 1, Exact(4), 4);  // room above the cap
     for (int i = 0; i < 30; ++i) {
       const double t = 2 * M_PI * ((i * 7 + seed * 3) % 30) / 30.0;
@@ -277,7 +277,7 @@ TEST_CASE("halfspace_intersection: nearly coincident planes") {
 // The same plane twice (scaled by 3, with a later index): the facet keeps the smaller
 // index, whichever route finds it.
 TEST_CASE("halfspace_intersection: a duplicate plane labels its facet by the first index") {
-  std::vector<HalfSpace> hs = cube_planes(1.0);
+  HalfSpaces hs = cube_planes(1.0);
   hs.push_back(plane(3, 0, 0, Exact(3), 6));
   hs.insert(hs.begin(), plane(0, 0, 3, Exact(3), -7));  // duplicate of +z, first
   for (int i = 0; i < static_cast<int>(hs.size()); ++i) hs[i].source = i;
@@ -290,7 +290,7 @@ TEST_CASE("halfspace_intersection: a duplicate plane labels its facet by the fir
 }
 
 TEST_CASE("halfspace_intersection: empty and flat intersections") {
-  std::vector<HalfSpace> hs = cube_planes(1.0);
+  HalfSpaces hs = cube_planes(1.0);
   hs.push_back(plane(1, 0, 0, Exact(-2), 6));
   CHECK(intersect_halfspaces(hs, {0, 0, 0}).reason == morph::EmptyReason::empty);
   hs.back() = plane(1, 0, 0, Exact(-1), 6);
@@ -349,7 +349,7 @@ TEST_CASE("halfspace_intersection: exact vertices plus doubles round as their ra
 // intersection is the same, exactly, and a wrong guess is caught by the check.
 TEST_CASE("halfspace_intersection: known points and an expected result give the same result") {
   const V3<Exact> apex = rational_apex();
-  std::vector<HalfSpace> hs = planes_through_apex(12);
+  HalfSpaces hs = planes_through_apex(12);
   const MaybePolytope plain = checked(hs);
   REQUIRE(plain.polytope);
   // The apex as X / W = (35, 21, 15) / 105, on the twelve tilted planes.
@@ -381,7 +381,7 @@ TEST_CASE("halfspace_intersection: known points and an expected result give the 
   const MaybePolytope guessed = intersect_halfspaces(hs, {0, 0, 0}, {}, known, expected);
   CHECK(guessed.route == HullRoute::expected);
   CHECK(difference(guessed, plain) == "");
-  std::vector<HalfSpace> cut = hs;
+  HalfSpaces cut = hs;
   cut.push_back(plane(0, 0, 1, apex.z - Exact(1) / Exact(100), static_cast<int>(cut.size())));
   const MaybePolytope wrong = intersect_halfspaces(cut, {0, 0, 0}, {}, {}, expected);
   CHECK(wrong.route == HullRoute::repaired);
@@ -397,7 +397,7 @@ TEST_CASE("halfspace_intersection: known points and an expected result give the 
 // edges (each edge a -> b with a < b searched once, setting its reverse too): the hull
 // computes the result, the same.
 TEST_CASE("halfspace_intersection: a guess that is not a closed surface is given up") {
-  const std::vector<HalfSpace> hs = planes_through_apex(12);
+  const HalfSpaces hs = planes_through_apex(12);
   const MaybePolytope plain = checked(hs);
   REQUIRE(plain.polytope);
   const Polytope& p = *plain.polytope;
@@ -738,7 +738,7 @@ TEST_CASE("halfspace_intersection: an erosion's lazy exact planes are the exact 
     if (c.lazy) CHECK(lazy > 0);
     // Copies, so that nothing is made yet where the input did not make it: four threads
     // read them all at once, in different orders.
-    const std::vector<HalfSpace> hs = in.halfspaces;
+    const HalfSpaces hs = in.halfspaces;
     constexpr int kThreads = 4;
     std::vector<std::vector<char>> same(kThreads, std::vector<char>(hs.size(), 0));
     {
@@ -760,7 +760,7 @@ TEST_CASE("halfspace_intersection: an erosion's lazy exact planes are the exact 
       CHECK(std::count(same[t].begin(), same[t].end(), 1) == static_cast<long>(hs.size()));
     // The intersection of lazy half-spaces (an opening's polytope reads every normal) is the
     // one of their eager copies.
-    std::vector<HalfSpace> eager = in.halfspaces;
+    HalfSpaces eager = in.halfspaces;
     for (HalfSpace& h : eager) {
       h.exact_normal();
       h.lazy = false;
@@ -1110,8 +1110,8 @@ HalfSpace plane_through(const V3<double>& n, const V3<ExactN>& p, int scale) {
 }
 
 /// Three half-spaces through p with normals a, b, c ordered so their det is positive.
-std::vector<HalfSpace> three_through(V3<double> a, V3<double> b, const V3<double>& c,
-                                     const V3<ExactN>& p, int scale) {
+HalfSpaces three_through(V3<double> a, V3<double> b, const V3<double>& c, const V3<ExactN>& p,
+                         int scale) {
   if (CGAL::sign(det(to_exact_n(a), to_exact_n(b), to_exact_n(c))) < 0) std::swap(a, b);
   return {plane_through(a, p, scale), plane_through(b, p, scale), plane_through(c, p, scale)};
 }
@@ -1164,7 +1164,7 @@ TEST_CASE("halfspace_intersection: the precise stage rounds vertices as the exac
           for (const bool given : {false, true}) {
             // given: each offset also as a double-double copy (HalfSpace::offset_dd, as an
             // erosion makes it), which the filters and the precise stage then take.
-            std::vector<HalfSpace> hs = three_through(n0, n1, n2, p, scale);
+            HalfSpaces hs = three_through(n0, n1, n2, p, scale);
             for (HalfSpace& h : hs) {
               double error;
               const DD d = to_dd(h.exact_offset(), error);
@@ -1392,10 +1392,9 @@ namespace {
 // through p moved by 2^-bits of the magnitude of <n, p> (sign: its direction), and three
 // through q (scaled by 2^q_scale), p moved along the fourth plane's normal by 2^-bits of p's
 // size (the sign of <n, p - q> is -sign).
-std::vector<HalfSpace> moved_fourth(const V3<ExactN>& p, int scale, int q_scale, int bits, int sign,
-                                    V3<ExactN>& q) {
-  std::vector<HalfSpace> hs =
-      three_through({1, 0.25, -0.5}, {-0.3, 1, 0.1}, {0.2, -0.7, 1}, p, scale);
+HalfSpaces moved_fourth(const V3<ExactN>& p, int scale, int q_scale, int bits, int sign,
+                        V3<ExactN>& q) {
+  HalfSpaces hs = three_through({1, 0.25, -0.5}, {-0.3, 1, 0.1}, {0.2, -0.7, 1}, p, scale);
   HalfSpace h = plane_through({0.3, 0.3, 0.9 + 0x1p-30}, p, scale);
   const V3<ExactN>& n = h.exact_normal();
   const double size = std::abs(n.x.to_double() * p.x.to_double()) +
@@ -1429,7 +1428,7 @@ TEST_CASE("halfspace_intersection: the precise determinant sign is exact") {
       for (double sign : {1.0, -1.0}) {
         const ExactN t(k == 0 ? 0.0 : sign * std::ldexp(1.0, -k));
         const V3<ExactN> n2{n0.x + n1.x + t * e.x, n0.y + n1.y + t * e.y, n0.z + n1.z + t * e.z};
-        std::vector<HalfSpace> hs;
+        HalfSpaces hs;
         for (const V3<ExactN>& n : {n0, n1, n2})
           hs.push_back(dyadic_halfspace({n.x * f, n.y * f, n.z * f}, ExactN(1)));
         const int want = CGAL::sign(det(n0, n1, n2));
@@ -1456,7 +1455,7 @@ TEST_CASE("halfspace_intersection: planes out of the precise range skip the prec
   const int want = CGAL::sign(det(n0, n1, n2));
   REQUIRE(want > 0);
   for (int e : {300, 500}) {
-    std::vector<HalfSpace> hs;
+    HalfSpaces hs;
     for (const V3<ExactN>& n : {n0, n1, n2}) hs.push_back(dyadic_halfspace(n, ExactN(1)));
     hs[1].offset() = ExactN(std::ldexp(1.0, e));
     const PreciseProbe probe = probe_precise(hs);
@@ -1482,7 +1481,7 @@ TEST_CASE("halfspace_intersection: the precise side and compare signs are exact"
       for (int bits : {20, 60, 90, 120}) {
         for (int sign : {1, -1}) {
           V3<ExactN> q;
-          std::vector<HalfSpace> hs = moved_fourth(p, scale, -scale, bits, sign, q);
+          HalfSpaces hs = moved_fourth(p, scale, -scale, bits, sign, q);
           const HalfSpace h = hs[3];
           const PreciseProbe probe = probe_precise(hs);
           const V3<ExactN>& n = h.exact_normal();
@@ -1516,8 +1515,7 @@ TEST_CASE("halfspace_intersection: the precise side and compare signs are exact"
 // decides, near zero it leaves the sign to the intervals and the exact stages below.
 TEST_CASE("halfspace_intersection: the double filter's signs are exact") {
   int decided = 0, undecided = 0, expected = 0;
-  const auto exact_meet = [](const std::vector<HalfSpace>& hs, int first, V3<ExactN>& X,
-                             ExactN& W) {
+  const auto exact_meet = [](const HalfSpaces& hs, int first, V3<ExactN>& X, ExactN& W) {
     const HalfSpace &a = hs[first], &b = hs[first + 1], &c = hs[first + 2];
     const V3<ExactN>&na = a.exact_normal(), &nb = b.exact_normal(), &nc = c.exact_normal();
     const ExactN &da = a.exact_offset(), &db = b.exact_offset(), &dc = c.exact_offset();
@@ -1531,7 +1529,7 @@ TEST_CASE("halfspace_intersection: the double filter's signs are exact") {
       for (int bits : {4, 12, 20, 40, 60, 90}) {
         for (int sign : {1, -1}) {
           V3<ExactN> q;
-          const std::vector<HalfSpace> hs = moved_fourth(p, scale, scale, bits, sign, q);
+          const HalfSpaces hs = moved_fourth(p, scale, scale, bits, sign, q);
           const HalfSpace& h = hs[3];
           V3<ExactN> Xu, Xv;
           ExactN Wu, Wv;
@@ -1576,7 +1574,7 @@ TEST_CASE("halfspace_intersection: vertices on rounding midpoints round to even"
     for (int k : {0, 80}) {
       const double x = std::ldexp(1.0, s), ulp = std::nextafter(x, HUGE_VAL) - x;
       const Exact m = Exact(x) + Exact(ulp / 2) + (k ? Exact(std::ldexp(ulp, -k)) : Exact(0));
-      std::vector<HalfSpace> hs;
+      HalfSpaces hs;
       const double axes[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
                                  {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
       for (const auto& a : axes)

@@ -239,7 +239,7 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
                            ExpectedVertices expected) {
   const std::vector<Location> loc = locate_all(A, B);
   const int nf = A.num_faces();
-  std::vector<HalfSpace> hs(nf);
+  HalfSpaces hs(nf);
   std::vector<char> on_plane(A.corner_vertex.size(), 0);  // per corner of A
   std::vector<int> contributing(nf);                      // the vertex of B moving f
   std::vector<std::vector<int>> others(nf);               // more vertices of B attaining h_B(N_f)
@@ -491,7 +491,7 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
                                           const Polytope& B) {
   const int nf = sum.num_faces(), na = A.num_faces();
   const bool doubles = A.exact_points.empty() && B.exact_points.empty();
-  std::vector<HalfSpace> hs(nf);
+  HalfSpaces hs(nf);
   std::vector<int> contributing(nf);
   // Facet g's further vertices of B attaining h_B: a span of B's corners (those of a facet
   // after its first) or of one[g] (an edge's other end); no list per facet to allocate.

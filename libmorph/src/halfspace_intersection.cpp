@@ -163,7 +163,7 @@ Interval neighbours_interval(const DD& c) {
   return c.hi > 0 ? Interval(toward, away) : Interval(away, toward);
 }
 
-Planes planes_of(const std::vector<HalfSpace>& hs) {
+Planes planes_of(const HalfSpaces& hs) {
   Planes planes(hs.size());
   parallel_chunks(static_cast<int>(hs.size()), 256, [&](int begin, int end) {
     RoundingGuard guard;
@@ -212,7 +212,7 @@ struct CentreResult {
   Exact t;
   V3<Exact> x;
 };
-CentreResult exact_centre(const std::vector<HalfSpace>& hs) {
+CentreResult exact_centre(const HalfSpaces& hs) {
   using Program = CGAL::Quadratic_program<Exact>;
   Program lp(CGAL::SMALLER, false, 0, false, 0);
   for (int i = 0; i < static_cast<int>(hs.size()); ++i) {
@@ -2337,7 +2337,7 @@ int away_sign(const Plane& p, const V3<double>& gc, const V3<double>& d) {
 /// `repaired`, when not null (a guess, with its triangles' vertices), allows edges that are
 /// not locally convex to be repaired (repair_surface) and the result checked again; it
 /// tells whether that happened. `given_ray`: the ray of the check before a repair.
-std::optional<MaybePolytope> build_verified(const std::vector<HalfSpace>& hs, const Planes& planes,
+std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& planes,
                                             const PrecisePlanes& precise, const KnownPoints& known,
                                             DualSurface s, const IntersectOptions& options,
                                             const std::shared_ptr<const void>& owner,
@@ -3387,7 +3387,7 @@ void probe_rounding(const HVertex& v, PreciseProbe& out) {
 
 }  // namespace
 
-PreciseProbe probe_precise(const std::vector<HalfSpace>& hs) {
+PreciseProbe probe_precise(const HalfSpaces& hs) {
   const Planes planes = planes_of(hs);
   RoundingGuard nearest(CGAL_FE_TONEAREST);
   const PrecisePlanes precise(planes);
@@ -3409,7 +3409,7 @@ PreciseProbe probe_precise(const std::vector<HalfSpace>& hs) {
   return out;
 }
 
-DoubleProbe probe_double(const std::vector<HalfSpace>& hs) {
+DoubleProbe probe_double(const HalfSpaces& hs) {
   const Planes planes = planes_of(hs);
   RoundingGuard guard;  // (vertex_of's intervals for planes that are not fast)
   DoubleProbe out;
@@ -3852,7 +3852,7 @@ DualSurface expected_surface(const Planes& planes, const PrecisePlanes& precise,
 
 }  // namespace
 
-MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& hs, const V3<double>& hint,
+MaybePolytope intersect_halfspaces(const HalfSpaces& hs, const V3<double>& hint,
                                    const IntersectOptions& options, const KnownPoints& known,
                                    const ExpectedVertices& expected,
                                    std::shared_ptr<const void> owner) {

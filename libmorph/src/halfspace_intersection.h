@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 
+#include "huge_pages.h"
 #include "polytope.h"
 #include "run_once.h"
 
@@ -166,6 +167,10 @@ struct HalfSpace {
   }
 };
 
+/// The half-spaces of an intersection, one per facet of A: tens of megabytes made afresh for
+/// each operation (huge_pages.h).
+using HalfSpaces = std::vector<HalfSpace, HugePageAllocator<HalfSpace>>;
+
 /// Sets h.normal_dd from h.normal = (p1 - p0) x (p2 - p0) for a triangle of double points
 /// (its Newell normal), when the differences are exact in doubles and the products and the
 /// bound allow; leaves h unchanged otherwise.
@@ -298,7 +303,7 @@ struct ExpectedVertices {
 /// optional: the result is the same, only faster). `owner`, when given, owns `halfspaces`
 /// and `known` (unchanged while it lives): the polytope's lazy exact points then keep it
 /// and read their exact planes and known points there; otherwise they copy what they need.
-MaybePolytope intersect_halfspaces(const std::vector<HalfSpace>& halfspaces, const V3<double>& hint,
+MaybePolytope intersect_halfspaces(const HalfSpaces& halfspaces, const V3<double>& hint,
                                    const IntersectOptions& options = {},
                                    const KnownPoints& known = {},
                                    const ExpectedVertices& expected = {},
@@ -318,7 +323,7 @@ struct PreciseProbe {
 };
 /// u is the meet of the planes of hs[0], hs[1] and hs[2] (det of their normals > 0 for all
 /// but `det`); v, when hs has 7 half-spaces, that of hs[4], hs[5] and hs[6].
-PreciseProbe probe_precise(const std::vector<HalfSpace>& hs);
+PreciseProbe probe_precise(const HalfSpaces& hs);
 /// The rounding of a point known exactly, X / W (W > 0), as an erosion's known points.
 PreciseProbe probe_precise_point(const V3<ExactN>& X, const ExactN& W);
 
@@ -331,7 +336,7 @@ struct DoubleProbe {
   int side = 2;
   int compare = 2;
 };
-DoubleProbe probe_double(const std::vector<HalfSpace>& hs);
+DoubleProbe probe_double(const HalfSpaces& hs);
 
 /// One coordinate of X / W + b rounded to nearest (ties to even), for X / W a vertex given
 /// by its precise coordinates (a PrecisePoint's X.x, error.x, W, w_error, or y, or z) and b a
@@ -380,7 +385,7 @@ Closing close_polytope(const Polytope& A, const Polytope& B, const IntersectOpti
 
 /// What an erosion hands to intersect_halfspaces (tests compare the closing's routes).
 struct ErosionInput {
-  std::vector<HalfSpace> halfspaces;
+  HalfSpaces halfspaces;
   V3<double> hint{0, 0, 0};
   KnownPoints known;
   ExpectedVertices expected;
