@@ -1217,10 +1217,11 @@ int det_sign(const Planes& planes, const PrecisePlanes& precise, int a, int b, i
 /// product and its inputs, one for the difference); each coordinate n_j / e is then within
 /// (2 u + u + E / e) of itself relative, taken as 1.25 times that, plus 2^-1073 / e for a
 /// normal component below the subnormal range. A plane gets a copy only when e > 0 with
-/// E <= 2^-20 e and |n|, d and p within [2^-400, 2^400] or 0 (no overflow in the tests;
-/// their underflow is within kDoubleFloor).
+/// E <= 2^-20 e and |n|, d and p within [2^-300, 2^300] or 0: a determinant of the points
+/// or their differences (below 2^301) then stays below 2^910 (no overflow), and what its
+/// products lose to underflow (2^-1074 each, times at most 2^301) is within kDoubleFloor.
 DualPoints dual_points(const Planes& planes, const V3<double>& o) {
-  constexpr double u = 0x1p-52, kLow = 0x1p-400, kHigh = 0x1p400;
+  constexpr double u = 0x1p-52, kLow = 0x1p-300, kHigh = 0x1p300;
   DualPoints out;
   const int n = static_cast<int>(planes.size());
   out.resize(n);
