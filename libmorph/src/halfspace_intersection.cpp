@@ -1269,6 +1269,14 @@ int dual_det_sign(const DualPoints& dual, int a, int b, int c) {
   return det_filter(x.p, y.p, z.p, x.error, y.error, z.error);
 }
 
+/// det_sign with the dual points' filter first, when there are dual points (upward
+/// rounding).
+int det_sign(const DualPoints* dual, const Planes& planes, const PrecisePlanes& precise, int a,
+             int b, int c) {
+  const int d = dual ? dual_det_sign(*dual, a, b, c) : 2;
+  return d != 2 ? d : det_sign(planes, precise, a, b, c);
+}
+
 /// Sign of plane i at the vertex of planes a, b, c (det(n_a, n_b, n_c) > 0) from the dual
 /// points, or 2 (upward rounding). Each difference errs by its points' errors and one
 /// rounding.
@@ -1620,10 +1628,8 @@ bool walk_to_cone(const DualSurface& s, const Planes& planes, const PrecisePlane
     for (int j = 0; j < 3 && to < 0; ++j) {
       const int k = (steps + j) % 3, w = s.across[u][k];
       if (w == from) continue;
-      const int a = s.corner[u][k], b = s.corner[u][k == 2 ? 0 : k + 1];
-      int d = dual ? dual_det_sign(*dual, a, b, x) : 2;
-      if (d == 2) d = det_sign(planes, precise, a, b, x);
-      if (d < 0) to = w;
+      if (det_sign(dual, planes, precise, s.corner[u][k], s.corner[u][k == 2 ? 0 : k + 1], x) < 0)
+        to = w;
     }
     if (to < 0) return true;
     from = u;
@@ -2357,9 +2363,8 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
       const HVertex& v = s.vertex[t];
       if (v.known < 0 && v.planes == s.corner[t] && w_positive(v)) return true;
     }
-    const auto [a, b, c] = s.corner[t];
-    const int d = s.dual ? dual_det_sign(*s.dual, a, b, c) : 2;
-    return (d != 2 ? d : det_sign(planes, precise, a, b, c)) > 0;
+    return det_sign(s.dual.get(), planes, precise, s.corner[t][0], s.corner[t][1], s.corner[t][2]) >
+           0;
   };
   std::atomic<bool> ok = true;
   parallel_chunks(s.oriented ? 0 : nt, 512, [&](int begin, int end) {
