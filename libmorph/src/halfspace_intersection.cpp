@@ -1277,12 +1277,14 @@ int det_sign(const DualPoints* dual, const Planes& planes, const PrecisePlanes& 
   return d != 2 ? d : det_sign(planes, precise, a, b, c);
 }
 
-/// Sign of plane i at the vertex of planes a, b, c (det(n_a, n_b, n_c) > 0) from the dual
-/// points, or 2 (upward rounding). Each difference errs by its points' errors and one
-/// rounding.
-int dual_side(const DualPoints& dual, int a, int b, int c, int i) {
+/// Sign of plane i at the vertex of planes abc (det(n_a, n_b, n_c) > 0) from the dual
+/// points, or 2 (none given, or undecided; upward rounding). Each difference errs by its
+/// points' errors and one rounding.
+int dual_side(const DualPoints* dual, const std::array<int, 3>& abc, int i) {
   constexpr double u = 0x1p-52;
-  const DualPoint &pa = dual[a], &pb = dual[b], &pc = dual[c], &pi = dual[i];
+  if (!dual) return 2;
+  const DualPoint &pa = (*dual)[abc[0]], &pb = (*dual)[abc[1]], &pc = (*dual)[abc[2]],
+                  &pi = (*dual)[i];
   const double ea = pa.error, eb = pb.error, ec = pc.error, ei = pi.error;
   if (ea < 0 || eb < 0 || ec < 0 || ei < 0) return 2;
   const V3<double>& q = pi.p;
@@ -1732,8 +1734,7 @@ class SurfaceRepair {
   /// Sign of plane i at the vertex of triangle t.
   int side_at(int i, int t) {
     if (dual_) {
-      const auto& c = s_.corner[t];
-      const int d = dual_side(*dual_, c[0], c[1], c[2], i);
+      const int d = dual_side(dual_, s_.corner[t], i);
       if (decided(d)) return d;
     }
     HVertex& v = vertex_at(t);
@@ -1931,7 +1932,7 @@ bool SurfaceRepair::lift(int t, int i) {
       std::optional<HVertex> v;
       int sx = 2;
       if (dual_) {
-        sx = dual_side(*dual_, za, zb, zc, x);
+        sx = dual_side(dual_, {za, zb, zc}, x);
         decided(sx);
       }
       if (sx == 2) {
@@ -2529,10 +2530,8 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
       for (int k = 0; k < 3; ++k) {
         if (far_side[3 * t + k] != 2) continue;
         const int far = s.far_corner(t, k);
-        const auto& c = s.corner[t];
-        int sd = far < 0 || !s.dual ? 2 : dual_side(*s.dual, c[0], c[1], c[2], far);
-        if (sd == 2)
-          sd = far < 0 ? 1 : known_through(known, far, v) ? 0 : side(planes, precise, far, v);
+        int sd = far < 0 ? 1 : dual_side(s.dual.get(), s.corner[t], far);
+        if (sd == 2) sd = known_through(known, far, v) ? 0 : side(planes, precise, far, v);
         note(sd);
         far_side[3 * t + k] = static_cast<signed char>(sd);
       }
@@ -2790,11 +2789,7 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
         }
       }
       // (After a walk, u is the vertex of the triangle it ended on: the dual points first.)
-      int sd = u_on ? 0 : 2;
-      if (sd == 2 && walked && s.dual) {
-        const auto& c = s.corner[start];
-        sd = dual_side(*s.dual, c[0], c[1], c[2], i);
-      }
+      int sd = u_on ? 0 : walked ? dual_side(s.dual.get(), s.corner[start], i) : 2;
       if (sd == 2) sd = side_of(i, u);
       if (sd > 0) {
         if (can_repair)
