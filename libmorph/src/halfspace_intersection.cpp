@@ -2355,6 +2355,8 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
   const int nt = static_cast<int>(s.corner.size());
   const int n = static_cast<int>(planes.size());
   if (nt == 0) return std::nullopt;
+  RepairCounts scratch;  // where the caller asks for no counts
+  RepairCounts& counts = options.counts ? *options.counts : scratch;
   // Every triangle sees o on its inner side: det(n_a, n_b, n_c) > 0 (dual points are the
   // normals scaled by positive factors).
   // A vertex the candidate computed from its corners' planes, in order (not a known point),
@@ -2556,10 +2558,7 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
       for (int k = 0; k < 3; ++k)
         if (far_side[3 * t + k] > 0) edges.emplace_back(t, k);
     s.far_side = std::move(far_side);
-    RepairCounts unused;
-    if (!repair_surface(planes, precise, known, s, edges,
-                        options.counts ? *options.counts : unused))
-      return std::nullopt;
+    if (!repair_surface(planes, precise, known, s, edges, counts)) return std::nullopt;
     *repaired = true;
     return build_verified(hs, planes, precise, known, std::move(s), options, owner, nullptr,
                           &check_ray);
@@ -2811,10 +2810,8 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
     }
     check_steps += steps;
   });
-  if (options.counts) {
-    options.counts->check_planes += static_cast<long>(others.size());
-    options.counts->check_steps += check_steps;
-  }
+  counts.check_planes += static_cast<long>(others.size());
+  counts.check_steps += check_steps;
   if (!ok) return std::nullopt;
   if (std::any_of(cut.begin(), cut.end(), [](int v) { return v >= 0; })) {
     // Planes the guess left out that cut it (a closing of a UV sphere, whose result is not
@@ -2840,9 +2837,7 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
       s.has_vertex.assign(nt, 0);
     }
     s.far_side = std::move(far_side);
-    RepairCounts unused;
-    if (!SurfaceRepair(planes, precise, known, s, options.counts ? *options.counts : unused)
-             .insert_cutting(cutting))
+    if (!SurfaceRepair(planes, precise, known, s, counts).insert_cutting(cutting))
       return std::nullopt;
     *repaired = true;
     return build_verified(hs, planes, precise, known, std::move(s), options, owner, nullptr,
