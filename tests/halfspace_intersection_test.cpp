@@ -483,14 +483,17 @@ std::string input_difference(const ErosionInput& got, const ErosionInput& want) 
     return "hints differ";
   const KnownPoints &p = got.known, &q = want.known;
   if (p.begin != q.begin || p.point != q.point) return "known incidences differ";
-  if (p.X.size() != q.X.size()) return "known point counts differ";
-  for (std::size_t k = 0; k < p.X.size(); ++k) {
-    if (!same3(p.X[k], q.X[k]) || p.W[k] != q.W[k]) return "known point " + std::to_string(k);
+  if (p.size() != q.size()) return "known point counts differ";
+  // (Either may hold its points as Mpzf or as double-doubles: compared by value.)
+  for (int k = 0; k < p.size(); ++k) {
+    const V3<ExactN> X = p.exact_X(k);
+    const ExactN W = p.exact_W(k);
+    if (!same3(X, q.exact_X(k)) || W != q.exact_W(k)) return "known point " + std::to_string(k);
     const auto encloses = [](const Interval& i, const ExactN& x) {
       return Exact(i.inf()) <= Exact(x) && Exact(x) <= Exact(i.sup());
     };
-    if (!encloses(p.Xi[k].x, p.X[k].x) || !encloses(p.Xi[k].y, p.X[k].y) ||
-        !encloses(p.Xi[k].z, p.X[k].z) || !encloses(p.Wi[k], p.W[k]))
+    if (!encloses(p.Xi[k].x, X.x) || !encloses(p.Xi[k].y, X.y) || !encloses(p.Xi[k].z, X.z) ||
+        !encloses(p.Wi[k], W))
       return "known point " + std::to_string(k) + " outside its enclosure";
     if (!same_interval(p.Xi[k].x, q.Xi[k].x) || !same_interval(p.Xi[k].y, q.Xi[k].y) ||
         !same_interval(p.Xi[k].z, q.Xi[k].z) || !same_interval(p.Wi[k], q.Wi[k]))
@@ -677,12 +680,67 @@ TEST_CASE("halfspace_intersection: an erosion's quadrilateral half-spaces are ex
       CHECK(h.exact_offset() == *top_a - *top_b);
       for (int j = in.known.begin[f]; j < in.known.begin[f + 1]; ++j) {
         const int k = in.known.point[j];
-        CHECK(dot(n, in.known.X[k]) == h.exact_offset() * in.known.W[k]);
+        CHECK(dot(n, in.known.exact_X(k)) == h.exact_offset() * in.known.exact_W(k));
       }
     }
     CHECK(quads > 0);
     const MaybePolytope r = eroded_three_ways(A, B);
     REQUIRE(r.polytope);
+  }
+}
+
+// An erosion of double points keeps its known points v - b as double-doubles (exact:
+// two_sum), each vertex there taking that copy as its precise and its exact value. The same
+// input with the points as Mpzf gives the same polytope, exact point by exact point, by the
+// same route (the guess, repaired), its rounding the exact one; also scaled by 2^+-200 (the precise
+// stage's range holds the copies) and far from the origin (lo non-zero: the points are not
+// doubles).
+TEST_CASE("halfspace_intersection: known points as double-doubles erode as Mpzf ones") {
+  const morph::Mesh& uv = sample("uvsphere_1600.off");
+  const morph::Mesh snub = morph::test::scaled(sample("snub_dodecahedron.off"), 0.25);
+  const morph::Mesh ico = morph::make_icosphere(1.0, 3);
+  const morph::Mesh small = morph::make_icosphere(0.25, 1);
+  struct Case {
+    const char* what;
+    morph::Mesh A, B;
+  };
+  const Case cases[] = {
+      {"uvsphere by a snub dodecahedron", uv, snub},
+      {"icosphere by a small icosphere", ico, small},
+      {"icosphere scaled by 2^200", morph::test::scaled(ico, 0x1p200),
+       morph::test::scaled(small, 0x1p200)},
+      {"icosphere scaled by 2^-200", morph::test::scaled(ico, 0x1p-200),
+       morph::test::scaled(small, 0x1p-200)},
+      {"uvsphere far from the origin", morph::test::translated(uv, {1e6, -3e5, 7e5}), snub},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(std::string(c.what));
+    const Polytope A = make_operand(c.A, "A"), B = make_operand(c.B, "B");
+    const ErosionInput in = erode_sum_input(A, A, B);
+    REQUIRE(in.known.size() > 0);
+    CHECK(static_cast<int>(in.known.dd.size()) == in.known.size());
+    CHECK(in.known.X.empty());
+    KnownPoints mpzf = in.known;
+    mpzf.dd.clear();
+    int not_doubles = 0;
+    for (int k = 0; k < in.known.size(); ++k) {
+      mpzf.X.push_back(in.known.exact_X(k));
+      mpzf.W.push_back(ExactN(1));
+      const V3<DD>& d = in.known.dd[k];
+      not_doubles += d.x.lo != 0 || d.y.lo != 0 || d.z.lo != 0;
+    }
+    if (std::string(c.what) == "uvsphere far from the origin") CHECK(not_doubles > 0);
+    IntersectOptions options;
+    options.polytope = true;
+    const ExpectedVertices guess{A.fan_begin, A.fan_face};  // erode_polytope's
+    const MaybePolytope got =
+        intersect_halfspaces(in.halfspaces, in.hint, options, in.known, guess);
+    const MaybePolytope want = intersect_halfspaces(in.halfspaces, in.hint, options, mpzf, guess);
+    REQUIRE(got.polytope);
+    CHECK(difference(got, want) == "");
+    CHECK(got.route == want.route);
+    CHECK(got.route == HullRoute::repaired);
+    CHECK(rounded_from_exact(got));
   }
 }
 

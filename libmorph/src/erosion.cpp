@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <numeric>
@@ -82,11 +83,13 @@ struct Cycles {
 
 /// erosion_points on facet cycles: `pair_of(v)` is vertex v's pair (X's vertex, B's vertex)
 /// when the eroded polytope is a sum X (+) B (`sum`; nx bounds X's vertices),
-/// `point_of(v, b, known, k)` sets known point k to the exact v - b (under a RoundingGuard),
-/// and `others_of(f)` is the span of facet f's further vertices of B attaining h_B.
+/// `point_of(v, b, known, k)` sets known point k to the exact v - b: its X, W, Xi and Wi
+/// (under a RoundingGuard), or when `as_dd` its dd alone (round-to-nearest; the enclosures
+/// are made here from it), and `others_of(f)` is the span of facet f's further vertices of B
+/// attaining h_B.
 template <class PairOf, class PointOf, class OthersOf>
 KnownPoints known_points(const Cycles& A, bool sum, int nx, const PairOf& pair_of,
-                         const PointOf& point_of, const std::vector<int>& contributing,
+                         const PointOf& point_of, bool as_dd, const std::vector<int>& contributing,
                          const OthersOf& others_of, const std::vector<char>& on_plane) {
   KnownPoints known;
   const int nf = A.num_faces(), nv = A.num_vertices;
@@ -140,13 +143,31 @@ KnownPoints known_points(const Cycles& A, bool sum, int nx, const PairOf& pair_o
     known.begin[f + 1] = kept;
   }
   known.point.resize(kept);
-  known.X.resize(np);
-  known.W.resize(np);
+  if (as_dd) {
+    known.dd.resize(np);
+  } else {
+    known.X.resize(np);
+    known.W.resize(np);
+  }
   known.Xi.resize(np);
   known.Wi.resize(np);
   parallel_chunks(np, 512, [&](int begin, int end) {
+    if (!as_dd) {
+      RoundingGuard guard;
+      for (int k = begin; k < end; ++k) point_of(creator[k].first, creator[k].second, known, k);
+      return;
+    }
+    {
+      RoundingGuard nearest(CGAL_FE_TONEAREST);
+      for (int k = begin; k < end; ++k) point_of(creator[k].first, creator[k].second, known, k);
+    }
     RoundingGuard guard;
-    for (int k = begin; k < end; ++k) point_of(creator[k].first, creator[k].second, known, k);
+    const auto enclosure = [](const DD& c) { return Interval(c.hi) + Interval(c.lo); };
+    for (int k = begin; k < end; ++k) {
+      const V3<DD>& d = known.dd[k];
+      known.Xi[k] = {enclosure(d.x), enclosure(d.y), enclosure(d.z)};
+      known.Wi[k] = Interval(1);
+    }
   });
   return known;
 }
@@ -166,14 +187,18 @@ KnownPoints erosion_points(const Polytope& A, const Polytope& B,
   if (sum)
     for (std::uint64_t key : A.sum_pairs) nx = std::max(nx, pair_first(key) + 1);
   const auto pair_of = [&](int v) { return A.sum_pairs[A.vertex_source[v]]; };
+  // Double points: each v - b exactly as a double-double (two_sum, exact where the
+  // difference does not overflow: every coordinate below 2^1022).
+  const auto below = [](const std::vector<V3<double>>& points) {
+    return std::all_of(points.begin(), points.end(), [](const V3<double>& p) {
+      return std::abs(p.x) < 0x1p1022 && std::abs(p.y) < 0x1p1022 && std::abs(p.z) < 0x1p1022;
+    });
+  };
+  const bool as_dd = A.exact_points.empty() && below(A.points) && below(B.points);
   const auto point_of = [&](int v, int b, KnownPoints& known, int k) {
-    if (A.exact_points.empty()) {
-      known.X[k] = exact_difference(A.points[v], B.points[b]);
-      known.W[k] = ExactN(1);
-      // The difference of two doubles, enclosed by rounding it both ways (no conversion
-      // back from Mpzf).
-      known.Xi[k] = to_interval(A.points[v]) - to_interval(B.points[b]);
-      known.Wi[k] = Interval(1);
+    if (as_dd) {
+      const V3<double>&p = A.points[v], &q = B.points[b];
+      known.dd[k] = {two_sum(p.x, -q.x), two_sum(p.y, -q.y), two_sum(p.z, -q.z)};
     } else {
       const ExactN& w = A.exact_points.W(v);
       const V3<ExactN> bn = to_exact_n(B.points[b]);
@@ -185,7 +210,7 @@ KnownPoints erosion_points(const Polytope& A, const Polytope& B,
   };
   const auto others_of = [&](int f) { return std::span<const int>(others[f]); };
   return known_points(Cycles{A.face_begin, A.corner_vertex, A.num_vertices()}, sum, nx, pair_of,
-                      point_of, contributing, others_of, on_plane);
+                      point_of, as_dd, contributing, others_of, on_plane);
 }
 
 }  // namespace
@@ -689,7 +714,7 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
   ErosionInput in;
   in.known = known_points(
       Cycles{sum.face_begin, corner_vertex, static_cast<int>(pairs.size())}, true, A.num_vertices(),
-      pair_of, point_of, contributing, [&](int g) { return others[g]; }, on_plane);
+      pair_of, point_of, false, contributing, [&](int g) { return others[g]; }, on_plane);
   // A's vertices, each with S's facets of its facets around it (the same facets by index).
   in.expected.begin = A.fan_begin;
   in.expected.split = false;

@@ -285,7 +285,8 @@ struct HVertex {
   bool precise = false;
   bool precise_tried = false;  // make_precise was called (it may have left it out)
   // A known point with W = 1 whose X is exactly px (hi + lo), pw = 1: its rounding is
-  // hi + lo in one rounded addition (make_precise).
+  // hi + lo in one rounded addition, and its exact X is made from px where X is null (a
+  // point of KnownPoints::dd; set_precise_known).
   bool exact_dd = false;
   bool doubles = false;  // a known point X / 1 with X exactly doubles: its rounding is X
   // Xi and Wi are set (`intervals`), or only the double filter's X and W with their
@@ -472,15 +473,27 @@ V3<Interval> enclosure_of(const Planes& planes, const HVertex& v) {
   return {widened(X.x, M.x) / W, widened(X.y, M.y) / W, widened(X.z, M.z) / W};
 }
 
-/// Makes v known point k, with its exact coordinates.
+void set_precise_known(const V3<DD>& d, HVertex& v);
+
+/// Makes v known point k, with its exact coordinates: KnownPoints' Mpzf, or its
+/// double-double copy, which is then v's precise one and its exact value (exact_dd; X made
+/// from it where it is read, make_exact).
 void set_known(const KnownPoints& known, int k, HVertex& v) {
   v.known = k;
   v.Xi = known.Xi[k];
   v.Wi = known.Wi[k];
   v.intervals = true;
   v.fast = false;
-  v.X = &known.X[k];
-  v.W = &known.W[k];
+  if (known.dd.empty()) {
+    v.X = &known.X[k];
+    v.W = &known.W[k];
+    return;
+  }
+  v.X = nullptr;
+  v.W = nullptr;
+  v.made.reset();
+  v.precise_tried = true;
+  set_precise_known(known.dd[k], v);
 }
 
 /// A vertex of three planes taken from a known point when the three pass through one (and
@@ -522,9 +535,14 @@ void set_exact(HVertex& v, V3<ExactN> X, ExactN W) {
   v.W = &v.made->W;
 }
 
-/// Computes the exact coordinates of a vertex, once.
+/// Computes the exact coordinates of a vertex, once: from its double-double copy when that
+/// is exact (a known point's, set_known), else as the meet of its planes.
 void make_exact(const Planes& planes, HVertex& v) {
   if (v.X) return;
+  if (v.exact_dd) {
+    set_exact(v, exact_value(v.px), ExactN(1));
+    return;
+  }
   const Plane &a = planes[v.planes[0]], &b = planes[v.planes[1]], &c = planes[v.planes[2]];
   v.made = std::make_unique<ExactCoordinates>();
   meet(a.n(), a.d(), b.n(), b.d(), c.n(), c.d(), v.made->X, v.made->W);
@@ -848,35 +866,39 @@ class PrecisePlanes {
   OnceFlags once_;
 };
 
+/// A known point's precise copy from its exact coordinates X = hi + lo, W = 1: the copy is
+/// exact (exact_dd: it rounds by hi + lo, and its exact value is made from it), and `doubles`
+/// when every lo is zero; precise (with precise_scaled's bound, for the scale 1) within
+/// precise_scaled's range.
+void set_precise_known(const V3<DD>& d, HVertex& v) {
+  v.px = d;
+  v.pw = {1, 0};
+  v.ex = {kPlaneRelative * std::abs(d.x.hi), kPlaneRelative * std::abs(d.y.hi),
+          kPlaneRelative * std::abs(d.z.hi)};
+  v.ew = kPlaneRelative;
+  v.exact_dd = true;
+  v.doubles = d.x.lo == 0 && d.y.lo == 0 && d.z.lo == 0;
+  bool in_range = true;
+  for (const DD& x : {d.x, d.y, d.z})
+    in_range = in_range && (x.hi == 0 || (std::abs(x.hi) >= 0x1p-900 && std::abs(x.hi) <= 0x1p400));
+  v.precise = in_range;
+}
+
 /// The precise coordinates of a vertex (round-to-nearest): a known point's from its exact
 /// ones (W in [1, 2)), another's as the meet of its precise planes. Left out when a plane is
 /// not valid or a value out of range.
 void make_precise(const PrecisePlanes& planes, HVertex& v) {
   v.precise_tried = true;
   if (v.known >= 0) {
+    if (v.exact_dd) return;  // (set_known's, from the known point's double-double copy)
     // W = 1 (an erosion's v - b of double points, a closing's exact sums): X is usually
     // exactly hi + lo, often one bit beyond a double (a rounding tie, which the precise
-    // rounding cannot settle). It is then doubles when every lo is zero, and otherwise
-    // rounds by hi + lo (exact_dd); its precise copy is that of precise_scaled below (the
-    // scale 1), but exact.
-    DD d[3];
-    if (v.W->is_one() && split_exactly(v.X->x, d[0]) && split_exactly(v.X->y, d[1]) &&
-        split_exactly(v.X->z, d[2])) {
-      v.doubles = d[0].lo == 0 && d[1].lo == 0 && d[2].lo == 0;
-      if (v.doubles) return;
-      bool in_range = true;  // (as precise_scaled's)
-      for (const DD& x : d)
-        in_range =
-            in_range && (x.hi == 0 || (std::abs(x.hi) >= 0x1p-900 && std::abs(x.hi) <= 0x1p400));
-      if (in_range) {
-        v.px = {d[0], d[1], d[2]};
-        v.pw = {1, 0};
-        v.ex = {kPlaneRelative * std::abs(d[0].hi), kPlaneRelative * std::abs(d[1].hi),
-                kPlaneRelative * std::abs(d[2].hi)};
-        v.ew = kPlaneRelative;
-        v.precise = v.exact_dd = true;
-        return;
-      }
+    // rounding cannot settle).
+    V3<DD> d;
+    if (v.W->is_one() && split_exactly(v.X->x, d.x) && split_exactly(v.X->y, d.y) &&
+        split_exactly(v.X->z, d.z)) {
+      set_precise_known(d, v);
+      return;
     }
     const auto is_double = [](const ExactN& x) {
       const double d = x.to_double();
@@ -970,8 +992,8 @@ int interval_side(const Planes& planes, const Plane& p, const HVertex& v) {
 
 /// Sign of <n, x> - d at a vertex from the filters alone (the double filter, the precise
 /// stage in round-to-nearest, then intervals), or 2: > 0 when the vertex violates the
-/// half-space. A known point skips the precise stage: its exact coordinates are there, and
-/// small (in a closing the undecided tests are mostly exact zeros, planes touching the
+/// half-space. A known point whose exact coordinates are there skips the precise stage: they
+/// are small (in a closing the undecided tests are mostly exact zeros, planes touching the
 /// result).
 int side_filter(const Planes& planes, const PrecisePlanes& precise, int i, const HVertex& v) {
   const Plane& p = planes[i];
@@ -979,7 +1001,7 @@ int side_filter(const Planes& planes, const PrecisePlanes& precise, int i, const
   if (s != 2) return s;
   // The precise stage before intervals (which a vertex with doubles would make here) when
   // the plane's precise copy is made already; after them otherwise (its conversion costs more).
-  const bool stage = v.precise && v.known < 0;
+  const bool stage = v.precise && (v.known < 0 || !v.X);
   const auto precise_sign = [&] {
     RoundingGuard nearest(CGAL_FE_TONEAREST);
     const PrecisePlane& q = precise[i];
@@ -1008,8 +1030,9 @@ int side(const Planes& planes, const PrecisePlanes& precise, int i, HVertex& v) 
   if (s != 2) return s;
   // A vertex the double filter cannot decide goes to the precise stage before intervals:
   // most of those the intervals cannot decide either, and the precise coordinates are
-  // needed for the rounding anyway.
-  if (v.known < 0) {
+  // needed for the rounding anyway. (A known point goes there only when its exact
+  // coordinates are not at hand: a double-double one, set_known.)
+  if (v.known < 0 || !v.X) {
     RoundingGuard nearest(CGAL_FE_TONEAREST);
     if (!v.precise_tried) make_precise(precise, v);
     const PrecisePlane& q = precise[i];
@@ -1395,7 +1418,7 @@ class VertexExactPoints final : public LazyExactPoints {
       }
     });
     for (const HVertex& v : vertex_) {
-      if (v.X) continue;
+      if (v.X || v.exact_dd) continue;  // (exact_dd: made from its own copy)
       for (int i : v.planes) {
         if (planes_[i].n_exact) continue;
         const Plane& p = planes[i];
@@ -2727,7 +2750,7 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
     if (some_triangle[p] < 0) others.push_back(p);
   std::vector<int> vertex_at_point;  // the vertex that is known point k, or -1
   if (!known.empty() && !others.empty()) {
-    vertex_at_point.assign(known.X.size(), -1);
+    vertex_at_point.assign(known.size(), -1);
     for (int v = 0; v < nv; ++v)
       if (vertex[v].known >= 0) vertex_at_point[vertex[v].known] = v;
   }
@@ -2964,12 +2987,12 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
       double rounded[3];
       const double inverse = v.precise ? 1 / v.pw.hi : 0;
       for (int i = 0; i < 3; ++i) {
-        if (v.doubles) {
-          rounded[i] = coordinate(*v.X, i).to_double();
-          continue;
-        }
         if (v.exact_dd) {  // X / 1 exactly hi + lo: the sum rounds it (ties to even)
           rounded[i] = coordinate(v.px, i).hi + coordinate(v.px, i).lo;
+          continue;
+        }
+        if (v.doubles) {
+          rounded[i] = coordinate(*v.X, i).to_double();
           continue;
         }
         if (v.precise && round_precise(coordinate(v.px, i), coordinate(v.ex, i), v.pw, v.ew,
@@ -3154,7 +3177,7 @@ class IncrementalHull {
       const int k = tri.known;
       if (p < n_ && known_.passes(p, k)) return 0;
       const int s = interval_sign(dot(h.ni, known_.Xi[k]) - h.di * known_.Wi[k]);
-      return s != 2 ? s : CGAL::sign(dot(h.n(), known_.X[k]) - h.d() * known_.W[k]);
+      return s != 2 ? s : CGAL::sign(dot(h.n(), known_.exact_X(k)) - h.d() * known_.exact_W(k));
     }
     const int s = interval_sign(dot(h.ni, tri.Xi) - h.di * tri.Wi);
     if (s != 2) return s;
@@ -3365,16 +3388,16 @@ DualSurface exact_dual_hull(const Planes& planes, const V3<Exact>& o) {
 namespace {
 
 void probe_rounding(const HVertex& v, PreciseProbe& out) {
-  if (v.doubles) {
-    out.rounded = {v.X->x.to_double(), v.X->y.to_double(), v.X->z.to_double()};
-    out.decided = {true, true, true};
-  }
-  if (!v.precise) return;
   if (v.exact_dd) {
     out.rounded = {v.px.x.hi + v.px.x.lo, v.px.y.hi + v.px.y.lo, v.px.z.hi + v.px.z.lo};
     out.decided = {true, true, true};
     return;
   }
+  if (v.doubles) {
+    out.rounded = {v.X->x.to_double(), v.X->y.to_double(), v.X->z.to_double()};
+    out.decided = {true, true, true};
+  }
+  if (!v.precise) return;
   const double inverse = 1 / v.pw.hi;
   out.decided = {round_precise(v.px.x, v.ex.x, v.pw, v.ew, inverse, out.rounded.x),
                  round_precise(v.px.y, v.ex.y, v.pw, v.ew, inverse, out.rounded.y),
@@ -3472,6 +3495,15 @@ void set_normal_dd(HalfSpace& h, const V3<double>& p0, const V3<double>& p1, con
   }
 }
 
+V3<ExactN> exact_value(const V3<DD>& p) {
+  const auto exact = [](const DD& c) { return ExactN(c.hi) + ExactN(c.lo); };
+  return {exact(p.x), exact(p.y), exact(p.z)};
+}
+
+// (GCC 12 takes Mpzf's freeing of its own limbs, inlined here, for a mismatched delete: a
+// false positive of -Wmismatched-new-delete, which depends on what the inliner does.)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
 HalfSpace make_halfspace(const V3<ExactN>& normal, const Exact& offset, int source) {
   HalfSpace h;
   h.normal() = normal;
@@ -3480,6 +3512,7 @@ HalfSpace make_halfspace(const V3<ExactN>& normal, const Exact& offset, int sour
   h.source = source;
   return h;
 }
+#pragma GCC diagnostic pop
 
 namespace {
 
@@ -3623,7 +3656,7 @@ bool triangulate_polygon(const Planes& planes, const PrecisePlanes& precise,
     v.X = nullptr;
     v.W = nullptr;
     v.known = -1;
-    v.precise = v.precise_tried = v.exact_dd = false;
+    v.precise = v.precise_tried = v.exact_dd = v.doubles = false;
     v.planes = {p[i], p[j], p[l]};
     const Plane &a = planes[p[i]], &b = planes[p[j]], &c = planes[p[l]];
     if (fast) {
