@@ -2537,10 +2537,21 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
           ++untested;
         }
       }
-      // (A stored vertex is made for every triangle: the repair and the steps below use it.)
-      if (untested == 0 && (!stored || s.has_vertex[t])) continue;
+      if (untested == 0) continue;
+      // The vertex is made where a test needs it (the dual points' filter decides most
+      // without it: making and storing every triangle's wrote an icosphere's 136 MB again);
+      // a stored one is kept for the repair and the steps below, which make the others
+      // where they need them.
+      bool made = stored && s.has_vertex[t];
       HVertex& v = stored ? s.vertex[t] : local;
-      if (!stored) {
+      const auto vertex = [&]() -> HVertex& {
+        if (made) return v;
+        made = true;
+        if (stored) {
+          v = independent_vertex_of(planes, s.corner[t], known);
+          s.has_vertex[t] = 1;
+          return v;
+        }
         // A polygon's triangles come in a row and, in a closing, share one known point: the
         // previous triangle's vertex is then this one's (nothing copied again).
         const int k =
@@ -2549,14 +2560,16 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
           v.planes = s.corner[t];
         else
           v = independent_vertex_of(planes, s.corner[t], known);
-      } else if (!s.has_vertex[t]) {
-        v = independent_vertex_of(planes, s.corner[t], known);
-      }
+        return v;
+      };
       for (int k = 0; k < 3; ++k) {
         if (far_side[3 * t + k] != 2) continue;
         const int far = s.far_corner(t, k);
         int sd = far < 0 ? 1 : dual_side(s.dual.get(), s.corner[t], far);
-        if (sd == 2) sd = known_through(known, far, v) ? 0 : side(planes, precise, far, v);
+        if (sd == 2) {
+          HVertex& w = vertex();
+          sd = known_through(known, far, w) ? 0 : side(planes, precise, far, w);
+        }
         note(sd);
         far_side[3 * t + k] = static_cast<signed char>(sd);
       }
@@ -2574,8 +2587,8 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
   });
   if (!ok) return std::nullopt;
   if (reflex) {
-    // Every triangle's vertex is computed now (stored): the repair keeps those it leaves.
-    std::fill(s.has_vertex.begin(), s.has_vertex.end(), 1);
+    // (The repair keeps the vertices stored for triangles it leaves, and makes others where
+    // it needs them.)
     std::vector<std::pair<int, int>> edges;
     for (int t = 0; t < nt; ++t)
       for (int k = 0; k < 3; ++k)
@@ -2628,9 +2641,18 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
   if (stored) {
     if (!simple)
       for (int g = 0; g < nv; ++g)
-        if (seed[g] != g) s.vertex[g] = std::move(s.vertex[seed[g]]);
+        if (seed[g] != g) {
+          s.has_vertex[g] = s.has_vertex[seed[g]];
+          if (s.has_vertex[g]) s.vertex[g] = std::move(s.vertex[seed[g]]);
+        }
     s.vertex.resize(nv);
     vertex = std::move(s.vertex);
+    // The seeds whose tests did not need their vertex.
+    parallel_chunks(nv, 256, [&](int begin, int end) {
+      RoundingGuard guard;
+      for (int g = begin; g < end; ++g)
+        if (!s.has_vertex[g]) vertex[g] = independent_vertex_of(planes, s.corner[seed[g]], known);
+    });
   } else {
     vertex.resize(nv);
     parallel_chunks(nv, 256, [&](int begin, int end) {
