@@ -744,6 +744,37 @@ TEST_CASE("halfspace_intersection: known points as double-doubles erode as Mpzf 
   }
 }
 
+// An eroded polytope reads its facets' exact normals from the erosion's half-spaces (kept
+// by the polytope, made exact on first read), from any thread, also once its operands are
+// gone: the same normals as the general build's copies, each the same reference each time.
+TEST_CASE("halfspace_intersection: an eroded polytope's normals are its half-spaces'") {
+  const auto eroded = [](bool direct) {
+    const Polytope A = make_operand(morph::make_icosphere(1.0, 3), "A");
+    const Polytope B = make_operand(morph::make_icosphere(0.25, 1), "B");
+    return erode_polytope(A, B, {.direct_polytope = direct});
+  };
+  const MaybePolytope lazy = eroded(true), copied = eroded(false);
+  REQUIRE(lazy.polytope);
+  REQUIRE(copied.polytope);
+  const Polytope &p = *lazy.polytope, &q = *copied.polytope;
+  REQUIRE(p.given_normals.size() == static_cast<std::size_t>(p.num_faces()));
+  REQUIRE(q.given_normals.size() == p.given_normals.size());
+  std::vector<const V3<ExactN>*> first(p.num_faces());
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 4; ++t)
+    threads.emplace_back([&, t] {
+      for (int f = t; f < p.num_faces(); f += 4) first[f] = &p.given_normals[f];
+    });
+  for (std::thread& t : threads) t.join();
+  int differ = 0;
+  for (int f = 0; f < p.num_faces(); ++f) {
+    const V3<ExactN>&m = p.given_normals[f], &n = q.given_normals[f];
+    differ += &m != first[f] || m.x != n.x || m.y != n.y || m.z != n.z;
+  }
+  CHECK(differ == 0);
+  CHECK(polytope_difference(p, q) == "");
+}
+
 // An erosion's triangles of double points in a small frame leave their exact normal and
 // offset lazy (made from fixed-point words on first read): zero until then, and then the
 // exact values, (q - p) x (r - p) and <n, p> - max_j <n, b_j>, also when several threads

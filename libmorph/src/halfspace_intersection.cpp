@@ -1546,6 +1546,22 @@ void sort_unique_lists(std::vector<int>& begin, std::vector<int>& list) {
   list.resize(kept);
 }
 
+/// An intersection's facet normals read from its half-spaces (facet f's is half-space
+/// face_halfspace[f]'s), which `owner` keeps: a lazy one's made on first read, by whichever
+/// thread reads first (HalfSpace::exact_normal).
+class HalfSpaceNormals final : public GivenNormals::Source {
+ public:
+  HalfSpaceNormals(const HalfSpaces& hs, std::vector<int> face_halfspace,
+                   std::shared_ptr<const void> owner)
+      : hs_(hs), face_halfspace_(std::move(face_halfspace)), owner_(std::move(owner)) {}
+  const V3<ExactN>& normal(int f) const override { return hs_[face_halfspace_[f]].exact_normal(); }
+
+ private:
+  const HalfSpaces& hs_;  // (owner_'s)
+  std::vector<int> face_halfspace_;
+  std::shared_ptr<const void> owner_;
+};
+
 /// The polytope of a verified intersection straight from its facet cycles (canonical
 /// numbering, counter-clockwise), each facet with its half-space's normal: what
 /// make_polytope builds from them, without its hash map, merge pass and checks. Those
@@ -1556,7 +1572,7 @@ void sort_unique_lists(std::vector<int>& begin, std::vector<int>& list) {
 /// of their first corner, each fan from its vertex's last corner.
 Polytope verified_polytope(std::vector<V3<double>> points, ExactPoints exact,
                            std::vector<int> face_begin, std::vector<int> corner_vertex,
-                           std::vector<V3<ExactN>> normals) {
+                           GivenNormals normals) {
   Polytope p;
   p.points = std::move(points);
   p.exact_points = std::move(exact);
@@ -3042,11 +3058,20 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
     rp.face_element[f] = hs[face_halfspace[f]].element;
   }
   if (with_polytope) {
-    std::vector<V3<ExactN>> normals(nf);
-    for (int f = 0; f < nf; ++f) normals[f] = hs[face_halfspace[f]].exact_normal();
     ExactPoints points = polytope_points(planes, vertex, order, options.eager_exact, owner);
     Polytope p;
+    // Facet f's normal is its half-space's: read from there where `owner` keeps the
+    // half-spaces (made exact on first read), else copied.
+    const auto copied = [&] {
+      std::vector<V3<ExactN>> normals(nf);
+      for (int f = 0; f < nf; ++f) normals[f] = hs[face_halfspace[f]].exact_normal();
+      return normals;
+    };
     if (options.direct_polytope) {
+      GivenNormals normals =
+          owner ? GivenNormals(std::make_shared<const HalfSpaceNormals>(hs, face_halfspace, owner),
+                               nf)
+                : GivenNormals(copied());
       p = verified_polytope(rp.points, std::move(points), face_begin, face_vertex,
                             std::move(normals));
     } else {
@@ -3054,7 +3079,7 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
       for (int f = 0; f < nf; ++f)
         faces.emplace_back(face_vertex.begin() + face_begin[f],
                            face_vertex.begin() + face_begin[f + 1]);
-      p = make_polytope(rp.points, std::move(points), faces, std::move(normals), "A (-) B");
+      p = make_polytope(rp.points, std::move(points), faces, copied(), "A (-) B");
     }
     for (auto& src : p.face_source) src = hs[face_halfspace[src]].source;
     out.polytope = std::move(p);

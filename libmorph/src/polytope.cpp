@@ -1143,6 +1143,17 @@ bool readable(const Mesh& mesh) {
 
 }  // namespace
 
+namespace {
+
+/// Facet f's normal of `normals[source[f]]`, for each f.
+GivenNormals remapped(const std::vector<V3<ExactN>>& normals, const std::vector<int>& source) {
+  std::vector<V3<ExactN>> out(source.size());
+  for (std::size_t f = 0; f < source.size(); ++f) out[f] = normals[source[f]];
+  return GivenNormals(std::move(out));
+}
+
+}  // namespace
+
 Polytope make_polytope(std::vector<V3<double>> points, ExactPoints exact_points,
                        const std::vector<std::vector<int>>& input_faces,
                        std::vector<V3<ExactN>> given_normals, const char* name) {
@@ -1156,11 +1167,7 @@ Polytope make_polytope(std::vector<V3<double>> points, ExactPoints exact_points,
   p.exact_points = std::move(exact_points);
   for (int round = 0;; ++round) {
     build_connectivity(p, faces, name);
-    if (!given_normals.empty()) {
-      p.given_normals.resize(faces.size());
-      for (std::size_t f = 0; f < faces.size(); ++f)
-        p.given_normals[f] = given_normals[face_source[f]];
-    }
+    if (!given_normals.empty()) p.given_normals = remapped(given_normals, face_source);
     p.compute_normals();
     UnionFind groups(p.num_faces());
     bool merged = false;
@@ -1272,9 +1279,7 @@ Polytope make_polytope(std::vector<V3<double>> points, ExactPoints exact_points,
     p.exact_points = std::move(epts);
     p.vertex_source = std::move(vsrc);
     build_connectivity(p, faces, name);
-    if (!given_normals.empty())
-      for (std::size_t f = 0; f < faces.size(); ++f)
-        p.given_normals[f] = given_normals[face_source[f]];
+    if (!given_normals.empty()) p.given_normals = remapped(given_normals, face_source);
     p.compute_normals();
   } else {
     p.vertex_source.resize(used);
