@@ -1468,20 +1468,22 @@ ExactPoints polytope_points(const Planes& planes, HVertices& vertex, const std::
   }
   exact.enclosure.resize(nv);
   exact.precise.resize(nv);
-  RoundingGuard guard;  // (make_intervals)
-  for (int r = 0; r < nv; ++r) {
-    const HVertex& v = vertex[order[r]];
-    exact.enclosure[r] = enclosure_of(planes, v);
-    PrecisePoint& p = exact.precise[r];
-    p.doubles = v.doubles;
-    if (v.precise) {
-      p.X = v.px;
-      p.W = v.pw;
-      p.error = v.ex;
-      p.w_error = v.ew;
-      p.valid = true;
+  parallel_chunks(nv, 1024, [&](int begin, int end) {
+    RoundingGuard guard;  // (make_intervals)
+    for (int r = begin; r < end; ++r) {
+      const HVertex& v = vertex[order[r]];
+      exact.enclosure[r] = enclosure_of(planes, v);
+      PrecisePoint& p = exact.precise[r];
+      p.doubles = v.doubles;
+      if (v.precise) {
+        p.X = v.px;
+        p.W = v.pw;
+        p.error = v.ex;
+        p.w_error = v.ew;
+        p.valid = true;
+      }
     }
-  }
+  });
   exact.lazy =
       std::make_shared<VertexExactPoints>(planes, std::move(vertex), order, std::move(owner));
   return exact;

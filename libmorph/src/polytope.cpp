@@ -267,18 +267,22 @@ void Polytope::compute_normals(bool units_known) {
   if (units_known) {
     // Nothing to compute.
   } else if (exact_points.empty()) {
-    for (int f = 0; f < nf; ++f)
-      unit_normals[f] = unit_newell(points, &corner_vertex[face_begin[f]], degree(f));
+    parallel_chunks(nf, 1024, [&](int begin, int end) {
+      for (int f = begin; f < end; ++f)
+        unit_normals[f] = unit_newell(points, &corner_vertex[face_begin[f]], degree(f));
+    });
   } else {
-    RoundingGuard guard;
-    std::vector<V3<Interval>> cycle;  // conversions from rationals are worth caching
-    for (int f = 0; f < nf; ++f) {
-      const int b = face_begin[f];
-      cycle.clear();
-      for (int k = 0; k < degree(f); ++k) cycle.push_back(interval_point(corner_vertex[b + k]));
-      unit_normals[f] = unit_of_enclosure(newell_normal<Interval>(
-          degree(f), [&](int i) -> const V3<Interval>& { return cycle[i]; }));
-    }
+    parallel_chunks(nf, 1024, [&](int begin, int end) {
+      RoundingGuard guard;
+      std::vector<V3<Interval>> cycle;  // conversions from rationals are worth caching
+      for (int f = begin; f < end; ++f) {
+        const int b = face_begin[f];
+        cycle.clear();
+        for (int k = 0; k < degree(f); ++k) cycle.push_back(interval_point(corner_vertex[b + k]));
+        unit_normals[f] = unit_of_enclosure(newell_normal<Interval>(
+            degree(f), [&](int i) -> const V3<Interval>& { return cycle[i]; }));
+      }
+    });
   }
   exact_cache_ = std::make_shared<LazySlots<V3<ExactN>>>(nf);
   precise_cache_ = std::make_shared<FlatSlots<PreciseNormal>>(nf);
