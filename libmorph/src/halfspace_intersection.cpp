@@ -342,6 +342,10 @@ struct DualSurface {
 
   /// The far plane of triangle t's edge k: the corner of the triangle across it that is not
   /// on the edge (-1: none, a degenerate neighbour).
+  /// Triangle t's stored vertex (`vertex` not empty), made now when it has none (needs a
+  /// RoundingGuard).
+  HVertex& stored_vertex(int t, const Planes& planes, const KnownPoints& known);
+
   int far_corner(int t, int k) const {
     const int a = corner[t][k], b = corner[t][k == 2 ? 0 : k + 1];
     int far = -1;
@@ -521,6 +525,14 @@ HVertex independent_vertex_of(const Planes& planes, const std::array<int, 3>& ab
   v.planes = abc;
   set_known(known, k, v);
   return v;
+}
+
+HVertex& DualSurface::stored_vertex(int t, const Planes& planes, const KnownPoints& known) {
+  if (!has_vertex[t]) {
+    vertex[t] = independent_vertex_of(planes, corner[t], known);
+    has_vertex[t] = 1;
+  }
+  return vertex[t];
 }
 
 /// Whether plane i is known to pass through vertex v (no arithmetic).
@@ -1751,13 +1763,7 @@ class SurfaceRepair {
       if (s_.corner[t][k] == a) return k;
     return -1;
   }
-  HVertex& vertex_at(int t) {
-    if (!s_.has_vertex[t]) {
-      s_.vertex[t] = independent_vertex_of(planes_, s_.corner[t], known_);
-      s_.has_vertex[t] = 1;
-    }
-    return s_.vertex[t];
-  }
+  HVertex& vertex_at(int t) { return s_.stored_vertex(t, planes_, known_); }
   /// Sign of det(n_a, n_b, n_c): the dual points' filter, then det_sign.
   int orientation(int a, int b, int c) const {
     if (dual_) {
@@ -2560,25 +2566,20 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
       // without it: making and storing every triangle's wrote an icosphere's 136 MB again);
       // a stored one is kept for the repair and the steps below, which make the others
       // where they need them.
-      bool made = stored && s.has_vertex[t];
-      HVertex& v = stored ? s.vertex[t] : local;
+      bool made = false;  // (local is t's vertex)
       const auto vertex = [&]() -> HVertex& {
-        if (made) return v;
+        if (stored) return s.stored_vertex(t, planes, known);
+        if (made) return local;
         made = true;
-        if (stored) {
-          v = independent_vertex_of(planes, s.corner[t], known);
-          s.has_vertex[t] = 1;
-          return v;
-        }
         // A polygon's triangles come in a row and, in a closing, share one known point: the
         // previous triangle's vertex is then this one's (nothing copied again).
         const int k =
             known.empty() ? -1 : known.common(s.corner[t][0], s.corner[t][1], s.corner[t][2]);
-        if (k >= 0 && k == v.known)
-          v.planes = s.corner[t];
+        if (k >= 0 && k == local.known)
+          local.planes = s.corner[t];
         else
-          v = independent_vertex_of(planes, s.corner[t], known);
-        return v;
+          local = independent_vertex_of(planes, s.corner[t], known);
+        return local;
       };
       for (int k = 0; k < 3; ++k) {
         if (far_side[3 * t + k] != 2) continue;
