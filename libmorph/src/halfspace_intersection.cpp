@@ -39,6 +39,7 @@
 #include <map>
 #include <memory>
 #include <numeric>
+#include <optional>
 #include <thread>
 
 #include "fims.h"
@@ -1460,6 +1461,20 @@ class VertexExactPoints final : public LazyExactPoints {
 /// (`vertex` is moved away): computed on demand (VertexExactPoints), with the precise
 /// coordinates, or, when `eager`, all computed now and without precise coordinates (the
 /// route before, which tests compare with).
+/// The box of a vertex's precise X / W (hi + lo within the error bounds; under the caller's
+/// RoundingGuard), when W's enclosure is positive: about an ulp wide where the meet's
+/// intervals, for nearly parallel planes, are thousands (an erosion's vertices: 5e-11 on a
+/// sphere of radius 1).
+std::optional<V3<Interval>> precise_enclosure(const HVertex& v) {
+  const auto enclose = [](const DD& x, double error) {
+    return Interval(x.hi) + Interval(x.lo) + Interval(-error, error);
+  };
+  const Interval W = enclose(v.pw, v.ew);
+  if (!(W.inf() > 0)) return std::nullopt;
+  return V3<Interval>{enclose(v.px.x, v.ex.x) / W, enclose(v.px.y, v.ex.y) / W,
+                      enclose(v.px.z, v.ex.z) / W};
+}
+
 ExactPoints polytope_points(const Planes& planes, HVertices& vertex, const std::vector<int>& order,
                             bool eager, std::shared_ptr<const void> owner) {
   const int nv = static_cast<int>(order.size());
@@ -1484,7 +1499,8 @@ ExactPoints polytope_points(const Planes& planes, HVertices& vertex, const std::
     RoundingGuard guard;  // (make_intervals)
     for (int r = begin; r < end; ++r) {
       const HVertex& v = vertex[order[r]];
-      exact.enclosure[r] = enclosure_of(planes, v);
+      exact.enclosure[r] = v.precise ? precise_enclosure(v).value_or(enclosure_of(planes, v))
+                                     : enclosure_of(planes, v);
       PrecisePoint& p = exact.precise[r];
       p.doubles = v.doubles;
       if (v.precise) {
@@ -1569,6 +1585,30 @@ class HalfSpaceNormals final : public GivenNormals::Source {
                    std::shared_ptr<const void> owner)
       : hs_(hs), face_halfspace_(std::move(face_halfspace)), owner_(std::move(owner)) {}
   const V3<ExactN>& normal(int f) const override { return hs_[face_halfspace_[f]].exact_normal(); }
+  /// The half-space's double-double copy, each component within 2^-101 of its |hi|
+  /// (HalfSpace::normal_dd), scaled by a power of two to a largest |hi| in [1, 2): no Mpzf.
+  bool precise(int f, PreciseNormal& out) const override {
+    const HalfSpace& h = hs_[face_halfspace_[f]];
+    if (!h.has_normal_dd) return false;
+    double largest = 0;
+    for (const DD& c : h.normal_dd) largest = std::max(largest, std::abs(c.hi));
+    if (!(largest > 0) || !std::isfinite(largest)) return false;
+    const int shift = -std::ilogb(largest);
+    if (std::abs(shift) > 900) return false;  // (precise_given's range)
+    out = {};
+    for (int i = 0; i < 3; ++i) {
+      const DD& c = h.normal_dd[i];
+      if (c.hi == 0) continue;  // exactly zero (within 2^-101 of 0): hi = lo = error = 0
+      out.hi[i] = std::ldexp(c.hi, shift);
+      out.lo[i] = std::ldexp(c.lo, shift);
+      // The bound scales exactly; so does lo, unless it comes out subnormal.
+      out.error[i] = 0x1p-101 * std::abs(out.hi[i]);
+      if (c.lo != 0 && std::abs(out.lo[i]) < std::numeric_limits<double>::min())
+        out.error[i] += 0x1p-1000;
+    }
+    out.valid = true;
+    return true;
+  }
 
  private:
   const HalfSpaces& hs_;  // (owner_'s)

@@ -155,15 +155,23 @@ class GivenNormals {
    public:
     virtual ~Source() = default;
     virtual const V3<ExactN>& normal(int f) const = 0;
+    /// Normal f's precise copy, when the source has one at hand without exact arithmetic
+    /// (false: none; `out` is then unset).
+    virtual bool precise(int /*f*/, PreciseNormal& /*out*/) const { return false; }
   };
   GivenNormals() = default;
   explicit GivenNormals(std::vector<V3<ExactN>> held) : held_(std::move(held)) {}
   GivenNormals(std::shared_ptr<const Source> source, std::size_t size)
       : source_(std::move(source)), size_(size) {}
   bool empty() const { return size() == 0; }
+  bool has_source() const { return source_ != nullptr; }
   std::size_t size() const { return source_ ? size_ : held_.size(); }
   const V3<ExactN>& operator[](std::size_t f) const {
     return source_ ? source_->normal(static_cast<int>(f)) : held_[f];
+  }
+  /// Normal f's precise copy from the source, when it has one (Source::precise).
+  bool precise(std::size_t f, PreciseNormal& out) const {
+    return source_ && source_->precise(static_cast<int>(f), out);
   }
 
  private:
