@@ -575,20 +575,41 @@ void build_connectivity(Polytope& p, const std::vector<std::vector<int>>& faces,
     p.face_begin.push_back(static_cast<int>(p.corner_vertex.size()));
   }
   const int nc = static_cast<int>(p.corner_vertex.size());
-  std::unordered_map<std::uint64_t, int> corner_of;  // directed edge -> corner where it starts
-  corner_of.reserve(nc * 2);
+  const int nv = p.num_vertices();
   std::vector<int> corner_face(nc);
-  for (int f = 0; f < p.num_faces(); ++f) {
-    for (int k = 0; k < p.degree(f); ++k) {
-      const int c = p.face_begin[f] + k;
-      corner_face[c] = f;
-      const int u = p.corner_vertex[c];
-      const int w = p.corner(f, (k + 1) % p.degree(f));
-      if (!corner_of.emplace(key(u, w), c).second)
-        fail(name, "edge " + std::to_string(u) + "-" + std::to_string(w) +
-                       " is used twice in one direction");
-    }
+  for (int f = 0; f < p.num_faces(); ++f)
+    std::fill(corner_face.begin() + p.face_begin[f], corner_face.begin() + p.face_begin[f + 1], f);
+  // Each vertex's outgoing corners, as (the edge's end, corner), sorted by the end: a
+  // directed edge is found by a search in its start's short list (a hash map of all the
+  // edges took 15% of a closing of a UV sphere of 320 x 320 facets, its random probes
+  // missing the cache).
+  std::vector<int> out_begin(nv + 1, 0);
+  for (int c = 0; c < nc; ++c) ++out_begin[p.corner_vertex[c] + 1];
+  for (int v = 0; v < nv; ++v) out_begin[v + 1] += out_begin[v];
+  std::vector<std::pair<int, int>> out(nc);
+  {
+    std::vector<int> cursor(out_begin.begin(), out_begin.end() - 1);
+    for (int f = 0; f < p.num_faces(); ++f)
+      for (int k = 0; k < p.degree(f); ++k) {
+        const int c = p.face_begin[f] + k;
+        out[cursor[p.corner_vertex[c]]++] = {p.corner(f, (k + 1) % p.degree(f)), c};
+      }
   }
+  for (int v = 0; v < nv; ++v) {
+    const auto first = out.begin() + out_begin[v], last = out.begin() + out_begin[v + 1];
+    std::sort(first, last);
+    const auto twice = std::adjacent_find(
+        first, last, [](const auto& x, const auto& y) { return x.first == y.first; });
+    if (twice != last)
+      fail(name, "edge " + std::to_string(v) + "-" + std::to_string(twice->first) +
+                     " is used twice in one direction");
+  }
+  // The corner where directed edge u -> w starts, or -1.
+  const auto corner_of = [&](int u, int w) {
+    const auto first = out.begin() + out_begin[u], last = out.begin() + out_begin[u + 1];
+    const auto it = std::lower_bound(first, last, std::pair<int, int>{w, -1});
+    return it != last && it->first == w ? it->second : -1;
+  };
   auto next_corner = [&](int c) {
     const int f = corner_face[c];
     return c + 1 == p.face_begin[f + 1] ? p.face_begin[f] : c + 1;
@@ -602,17 +623,16 @@ void build_connectivity(Polytope& p, const std::vector<std::vector<int>>& faces,
   for (int c = 0; c < nc; ++c) {
     if (p.corner_edge[c] >= 0) continue;
     const int u = p.corner_vertex[c], w = p.corner_vertex[next_corner(c)];
-    auto twin = corner_of.find(key(w, u));
-    if (twin == corner_of.end())
+    const int twin = corner_of(w, u);
+    if (twin < 0)
       fail(name, "edge " + std::to_string(u) + "-" + std::to_string(w) + " has only one facet");
     const int e = static_cast<int>(p.edges.size());
-    p.edges.push_back({u, w, corner_face[c], corner_face[twin->second]});
+    p.edges.push_back({u, w, corner_face[c], corner_face[twin]});
     p.corner_edge[c] = e;
-    p.corner_edge[twin->second] = e;
+    p.corner_edge[twin] = e;
   }
   // Fans: from facet f at v, the next facet counter-clockwise is the one across f's
   // incoming edge u -> v, i.e. the facet holding v -> u.
-  const int nv = p.num_vertices();
   std::vector<int> some_corner(nv, -1);
   for (int c = 0; c < nc; ++c) some_corner[p.corner_vertex[c]] = c;
   p.fan_begin.assign(nv + 1, 0);
@@ -630,7 +650,7 @@ void build_connectivity(Polytope& p, const std::vector<std::vector<int>>& faces,
       p.fan_face.push_back(corner_face[c]);
       p.fan_edge.push_back(p.corner_edge[prev_corner(c)]);
       p.fan_vertex.push_back(u);
-      c = corner_of.at(key(v, u));
+      c = corner_of(v, u);  // (there: u -> v has a twin)
       if (++guard > nc) fail(name, "vertex " + std::to_string(v) + " has a broken fan");
     } while (c != start);
   }
