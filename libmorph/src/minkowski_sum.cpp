@@ -13,7 +13,6 @@
 #include <numeric>
 
 #include "fims.h"
-#include "/tmp/repro/prof.h"
 #include "gauss_map.h"
 #include "halfspace_intersection.h"
 #include "parallel.h"
@@ -915,10 +914,9 @@ namespace {
 /// sum_mesh; `movable`: facets.origins, when the caller no longer needs them.
 LabelledMesh sum_mesh(const Polytope& A, const Polytope& B, const SumFacets& facets,
                       std::vector<FacetOrigin>* movable) {
-  Lap lap("sum ");
   std::vector<std::uint64_t> pairs;
   std::vector<int> corners;
-  index_vertices(facets, A.num_vertices(), B.num_vertices(), pairs, corners); lap("index");
+  index_vertices(facets, A.num_vertices(), B.num_vertices(), pairs, corners);
   std::vector<V3<double>> points(pairs.size());
   const bool exact = !A.exact_points.empty() || !B.exact_points.empty();
   // Sums of double points are three additions each: split only in large chunks (at 1430
@@ -942,9 +940,9 @@ LabelledMesh sum_mesh(const Polytope& A, const Polytope& B, const SumFacets& fac
         point[v] = round_exact_sum(A, pair_first(pair[v]), B, pair_second(pair[v]));
     }
   });
-  std::vector<int> source; lap("round");
+  std::vector<int> source;
   // Initialised in place: OpenMesh meshes have no move assignment, only a deep copy.
-  LabelledMesh out{clean_mesh(points, facets.face_begin, std::move(corners), &source), {}}; lap("clean");
+  LabelledMesh out{clean_mesh(points, facets.face_begin, std::move(corners), &source), {}};
   // Each facet its own face (nothing merged, the usual case): the facets' origins as they are.
   bool same = movable && source.size() == movable->size();
   for (std::size_t i = 0; same && i < source.size(); ++i) same = source[i] == static_cast<int>(i);
