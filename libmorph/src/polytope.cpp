@@ -281,6 +281,17 @@ void Polytope::compute_normals(bool units_known) {
   precise_cache_ = std::make_shared<FlatSlots<PreciseNormal>>(nf);
   if (units_known) {
     // Nothing to compute.
+  } else if (given_normals.has_source()) {
+    // Normals given by a source (an erosion's half-spaces): the unit normal from the precise
+    // one (the half-space's double-double copy, else its exact normal's, made already where
+    // there is no copy), as tight as a double point's Newell normal, and kept. The vertices'
+    // enclosures give loose ones (an erosion's vertices of nearly parallel planes: at
+    // icosphere level 6 by its rotated copy, about 2e-5 against 1e-14 from the meets'
+    // intervals), which left the next sum's double filters undecided nearly everywhere.
+    parallel_chunks(nf, 1024, [&](int begin, int end) {
+      RoundingGuard nearest(CGAL_FE_TONEAREST);  // (the precise copies' splits)
+      for (int f = begin; f < end; ++f) unit_normals[f] = unit_of_precise(precise_normal(f));
+    });
   } else if (exact_points.empty()) {
     parallel_chunks(nf, 1024, [&](int begin, int end) {
       for (int f = begin; f < end; ++f)
@@ -291,17 +302,6 @@ void Polytope::compute_normals(bool units_known) {
       RoundingGuard guard;
       std::vector<V3<Interval>> cycle;  // conversions from rationals are worth caching
       for (int f = begin; f < end; ++f) {
-        // Normals given by a source (an erosion's half-spaces): the unit normal from the
-        // precise one (the half-space's double-double copy, else its exact normal's, made
-        // already where there is no copy), as tight as a double point's Newell normal, and
-        // kept. The vertices' enclosures give loose ones (an erosion's vertices of nearly
-        // parallel planes: at icosphere level 6 by its rotated copy, about 2e-5 against
-        // 1e-14 from the meets' intervals), which left the next sum's double filters
-        // undecided nearly everywhere.
-        if (given_normals.has_source()) {
-          unit_normals[f] = unit_of_precise(precise_normal(f));
-          continue;
-        }
         const int b = face_begin[f];
         cycle.clear();
         for (int k = 0; k < degree(f); ++k) cycle.push_back(interval_point(corner_vertex[b + k]));
