@@ -1457,10 +1457,6 @@ class VertexExactPoints final : public LazyExactPoints {
   std::shared_ptr<const void> owner_;  // of what planes_ and vertex_ point at, or null
 };
 
-/// The exact points of the intersection's polytope, whose vertex r is vertex[order[r]]
-/// (`vertex` is moved away): computed on demand (VertexExactPoints), with the precise
-/// coordinates, or, when `eager`, all computed now and without precise coordinates (the
-/// route before, which tests compare with).
 /// The box of a vertex's precise X / W (hi + lo within the error bounds; under the caller's
 /// RoundingGuard), when W's enclosure is positive: about an ulp wide where the meet's
 /// intervals, for nearly parallel planes, are thousands (an erosion's vertices: 5e-11 on a
@@ -1475,6 +1471,10 @@ std::optional<V3<Interval>> precise_enclosure(const HVertex& v) {
                       enclose(v.px.z, v.ex.z) / W};
 }
 
+/// The exact points of the intersection's polytope, whose vertex r is vertex[order[r]]
+/// (`vertex` is moved away): computed on demand (VertexExactPoints), with the precise
+/// coordinates, or, when `eager`, all computed now and without precise coordinates (the
+/// route before, which tests compare with).
 ExactPoints polytope_points(const Planes& planes, HVertices& vertex, const std::vector<int>& order,
                             bool eager, std::shared_ptr<const void> owner) {
   const int nv = static_cast<int>(order.size());
@@ -1499,8 +1499,9 @@ ExactPoints polytope_points(const Planes& planes, HVertices& vertex, const std::
     RoundingGuard guard;  // (make_intervals)
     for (int r = begin; r < end; ++r) {
       const HVertex& v = vertex[order[r]];
-      exact.enclosure[r] = v.precise ? precise_enclosure(v).value_or(enclosure_of(planes, v))
-                                     : enclosure_of(planes, v);
+      const std::optional<V3<Interval>> tight =
+          v.precise ? precise_enclosure(v) : std::optional<V3<Interval>>();
+      exact.enclosure[r] = tight ? *tight : enclosure_of(planes, v);
       PrecisePoint& p = exact.precise[r];
       p.doubles = v.doubles;
       if (v.precise) {
