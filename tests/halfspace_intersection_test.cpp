@@ -1252,46 +1252,6 @@ TEST_CASE("halfspace_intersection: the dual points' filter decides as the planes
   }
 }
 
-// A guess's polygon of four quadrilaterals around a vertex v of A, all moved by one vertex of
-// B (a UV sphere's), has its diagonal decided on the planes translated to v
-// (ExpectedVertices::local): the four planes nearly meet in one point, which the planes'
-// own filters leave to their precise stage. Each sign it decides is also computed the
-// planes' way (verify_local) and must agree, and the erosion is the same without it, with
-// the same repair.
-TEST_CASE("halfspace_intersection: translated quadrilaterals decide as the planes do") {
-  struct Case {
-    morph::Mesh A, B;
-  };
-  const Case cases[] = {
-      {morph::make_uv_sphere(1.0, 64), morph::test::scaled(sample("snub_dodecahedron.off"), 0.25)},
-      {morph::make_uv_sphere(1.0, 120), morph::test::cube(0.3)},
-      {morph::test::transformed(morph::make_uv_sphere(1.0, 48), morph::test::random_rotation(7)),
-       morph::test::scaled(sample("snub_dodecahedron.off"), 0.25)},
-      {morph::make_uv_sphere(2.0, 40),
-       morph::test::translated(morph::test::rotated_cube_triangles(0.5, 3), {0.25, 0.1, -0.05})},
-  };
-  for (const Case& c : cases) {
-    const Polytope A = make_operand(c.A, "A");
-    const Polytope B = make_operand(c.B, "B");
-    CAPTURE(A.num_faces());
-    RepairCounts with, without;
-    const MaybePolytope r = erode_polytope(A, B, {.counts = &with, .verify_local = true});
-    REQUIRE(r.polytope);
-    CHECK(difference(erode_polytope(A, B, {.counts = &without, .local_quads = false}), r) == "");
-    CHECK(with.local_mismatches == 0);
-    CAPTURE(with.local_decided);
-    CAPTURE(with.local_undecided);
-    CHECK(with.local_decided > 100);
-    CHECK(with.local_decided > 10 * with.local_undecided);
-    CHECK(without.local_decided + without.local_undecided == 0);
-    CHECK(with.flips == without.flips);
-    CHECK(with.removals == without.removals);
-    CHECK(with.lifts == without.lifts);
-    CHECK(with.insertions == without.insertions);
-    CHECK(with.check_planes == without.check_planes);
-  }
-}
-
 namespace {
 
 /// The exact value of a dyadic ExactN as a rational.

@@ -6,10 +6,8 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cmath>
 #include <cstdint>
-#include <limits>
 #include <memory>
 #include <numeric>
 #include <optional>
@@ -262,44 +260,6 @@ void set_fixed_plane(HalfSpace& h, const fixed::Normal& n, int doubling, const V
   h.has_offset_dd = n.set_dot(doubling, top, sub, h.offset(), &h.offset_dd);
 }
 
-/// ExpectedVertices::local for an erosion whose polygons are A's vertex fans: a fan's
-/// entries where its facets are all quadrilaterals with a height (quad_height, not NaN) and
-/// all moved by one vertex of B; NaN for the whole fan otherwise. Empty when no fan has them.
-void local_offsets(const Polytope& A, const std::vector<int>& contributing,
-                   const std::vector<char>& on_plane, const std::vector<double>& quad_height,
-                   ExpectedVertices& expected) {
-  const int nv = A.num_vertices();
-  std::vector<double> local(expected.facets.size());
-  std::atomic<bool> any = false;
-  parallel_chunks(nv, 256, [&](int begin, int end) {
-    bool some = false;
-    for (int v = begin; v < end; ++v) {
-      const int first = A.fan_begin[v], last = A.fan_begin[v + 1];
-      bool known = expected.begin[v] == first && expected.begin[v + 1] == last;
-      for (int j = first; j < last && known; ++j) {
-        const int f = A.fan_face[j];
-        known = expected.facets[j] == f && !std::isnan(quad_height[f]) &&
-                contributing[f] == contributing[A.fan_face[first]];
-      }
-      for (int j = first; j < last; ++j) {
-        local[j] = std::numeric_limits<double>::quiet_NaN();
-        if (!known) continue;
-        const int f = A.fan_face[j];
-        // v's corner in f (a quadrilateral): on f's plane, or |h_f| below it.
-        for (int k = 0; k < 4; ++k)
-          if (A.corner(f, k) == v) local[j] = on_plane[A.face_begin[f] + k] ? 0.0 : quad_height[f];
-        if (std::isnan(local[j])) known = false;  // (not a corner: not a fan, no local values)
-      }
-      if (!known)
-        std::fill(local.begin() + first, local.begin() + last,
-                  std::numeric_limits<double>::quiet_NaN());
-      some = some || known;
-    }
-    if (some) any = true;
-  });
-  if (any) expected.local = std::move(local);
-}
-
 ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b,
                            ExpectedVertices expected) {
   const std::vector<Location> loc = locate_all(A, B);
@@ -308,18 +268,6 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
   std::vector<char> on_plane(A.corner_vertex.size(), 0);  // per corner of A
   std::vector<int> contributing(nf);                      // the vertex of B moving f
   std::vector<std::vector<int>> others(nf);               // more vertices of B attaining h_B(N_f)
-  // Each quadrilateral's Newell normal and height in doubles (ExpectedVertices::local), where
-  // the polygons are A's vertex fans of double points: NaN heights where not made.
-  bool fans = sum_of_b == SumOfB::no && A.given_normals.empty() && A.exact_points.empty() &&
-              B.exact_points.empty() && expected.begin.size() == A.fan_begin.size() &&
-              expected.facets.size() == A.fan_face.size();
-  if (fans) {
-    int f = 0;
-    while (f < nf && A.degree(f) != 4) ++f;
-    fans = f < nf;
-  }
-  std::vector<V3<double>> quad_normal(fans ? nf : 0);
-  std::vector<double> quad_height(fans ? nf : 0, std::numeric_limits<double>::quiet_NaN());
   // (For the fixed-point frames below.)
   const std::vector<fixed::Span> spans = A.given_normals.empty() && B.exact_points.empty()
                                              ? vertex_spans(A)
@@ -403,12 +351,6 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
           const fixed::Normal n(frame, p0, p2, p1, p3);
           const int top = set_top(n.sign_dot(p1, p0));
           set_fixed(n, top == 1 ? p1 : p0, pb);
-          std::array<DD, 3> normal;
-          double height;
-          if (fans && n.normal_dd(0, normal) && n.dot_double(p1, p0, height)) {
-            quad_normal[f] = {normal[0].hi, normal[1].hi, normal[2].hi};
-            quad_height[f] = std::abs(height);
-          }
           add_others_on_plane();
           continue;
         }
@@ -460,8 +402,6 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
       }
     }
   });
-  if (fans) local_offsets(A, contributing, on_plane, quad_height, expected);
-  if (!expected.local.empty()) expected.local_normal = std::move(quad_normal);
   ErosionInput in;
   in.known = erosion_points(A, B, contributing, others, on_plane, sum_of_b);
   // A point usually inside: A's vertex centroid minus B's.
@@ -487,7 +427,7 @@ MaybePolytope erode_polytope(const Polytope& A, const Polytope& B,
   // shared with the result, whose lazy exact points (an opening) read its planes and known
   // points rather than copies.
   const auto in = std::make_shared<const ErosionInput>(
-      erosion_input(A, B, SumOfB::no, {.begin = A.fan_begin, .facets = A.fan_face}));
+      erosion_input(A, B, SumOfB::no, {A.fan_begin, A.fan_face}));
   return intersect_halfspaces(in->halfspaces, in->hint, options, in->known, in->expected, in);
 }
 

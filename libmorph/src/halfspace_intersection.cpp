@@ -3629,54 +3629,7 @@ struct PolygonScratch {
   std::vector<V3<double>> dual;    // their dual points about o, in plain doubles
   std::vector<signed char> diagonal_side;  // of diagonal i, j (k i + j, i < j), or 2
   std::vector<int> owner;  // 4 t + slot of the triangle t holding edge i -> j (k i + j), or -1
-  // The polygon's translated planes (ExpectedVertices::local), or null; what they decided.
-  const double* local = nullptr;
-  const V3<double>* local_normal = nullptr;
-  bool verify_local = false;
-  long local_decided = 0, local_undecided = 0, local_mismatches = 0;
 };
-
-/// The side of the plane at position q of a polygon at the vertex of those at positions i, j,
-/// l (a triangle, in order), as `side` gives it, from the polygon's planes translated to its
-/// vertex (ExpectedVertices::local: normals n and offsets d): the sign of
-/// <n_q, d_i (n_j x n_l) + d_j (n_l x n_i) + d_l (n_i x n_j)> - d_q <n_i, n_j x n_l>, the
-/// determinant of the four rows (n, -d) up to the rows' positive scales. 2 where the bound
-/// cannot tell. The inputs are within 2^-52 of their values (relative, per component), and
-/// the evaluation rounds each monomial at most 9 times, in any rounding mode an ulp at most:
-/// the error is below 13.1 ulps of the sum of the monomials' magnitudes, taken as 32; with
-/// every non-zero input within [2^-250, 2^250], products of four are normal (no underflow
-/// but in cancelled sums, which are exact), and 2^-960 covers the rest.
-int local_side(const PolygonScratch& scratch, const int* p, int i, int j, int l, int q) {
-  const V3<double>&a = scratch.local_normal[p[i]], &b = scratch.local_normal[p[j]],
-        &c = scratch.local_normal[p[l]], &e = scratch.local_normal[p[q]];
-  const double da = scratch.local[i], db = scratch.local[j], dc = scratch.local[l],
-               de = scratch.local[q];
-  const auto in_range = [](double x) {
-    const double m = std::abs(x);
-    return m == 0 || (m >= 0x1p-250 && m <= 0x1p250);  // (false for NaN)
-  };
-  for (const V3<double>* n : {&a, &b, &c, &e})
-    if (!in_range(n->x) || !in_range(n->y) || !in_range(n->z)) return 2;
-  for (const double d : {da, db, dc, de})
-    if (!in_range(d)) return 2;
-  const V3<double> bc = cross(b, c), ca = cross(c, a), ab = cross(a, b);
-  const V3<double> X{da * bc.x + db * ca.x + dc * ab.x, da * bc.y + db * ca.y + dc * ab.y,
-                     da * bc.z + db * ca.z + dc * ab.z};
-  const double value = dot(e, X) - de * dot(a, bc);
-  const auto abs3 = [](const V3<double>& v) {
-    return V3<double>{std::abs(v.x), std::abs(v.y), std::abs(v.z)};
-  };
-  const V3<double> ma = abs3(a), mb = abs3(b), mc = abs3(c), me = abs3(e);
-  const V3<double> mbc = magnitude_cross(mb, mc), mca = magnitude_cross(mc, ma),
-                   mab = magnitude_cross(ma, mb);
-  const V3<double> MX{da * mbc.x + db * mca.x + dc * mab.x, da * mbc.y + db * mca.y + dc * mab.y,
-                      da * mbc.z + db * mca.z + dc * mab.z};
-  const double magnitude = dot(me, MX) + de * dot(ma, mbc);
-  const double bound = 32 * 0x1p-52 * magnitude + 0x1p-960;
-  if (value > bound) return 1;
-  if (value < -bound) return -1;
-  return 2;
-}
 
 /// Flips per corner after which a polygon's triangulation stops: Lawson's flips may take
 /// O(k^2) on a vertex of A of high degree, and where planes of the polygon vanish (a UV
@@ -3888,25 +3841,13 @@ bool triangulate_polygon(const Planes& planes, const PrecisePlanes& precise,
     if (t < 0 || u < 0) continue;  // flipped away meanwhile
     const int b = triangle[t][i == 0 ? 2 : i - 1], d = triangle[u][j == 0 ? 2 : j - 1];
     // Plane d at t's vertex, or the same sign from the other side when only u's is made:
-    // plane b at the vertex of u = (c, a, d) (see build_verified's far-plane tests). First on
-    // the translated planes, where the polygon has them (t's orientation is then left to
-    // the check, as an untested triangle's).
-    int sd = 2;
-    if (scratch.local) {
-      sd = local_side(scratch, p, triangle[t][0], triangle[t][1], triangle[t][2], d);
-      ++(sd != 2 ? scratch.local_decided : scratch.local_undecided);
-      if (sd != 2 && scratch.verify_local) {
-        if (!make_vertex(t)) return false;
-        if (side_of(d, vertex[t]) != sd) ++scratch.local_mismatches;
-      }
-    }
-    if (sd == 2) {
-      if (!ready[t] && ready[u]) {
-        sd = side_of(b, vertex[u]);
-      } else {
-        if (!make_vertex(t)) return false;
-        sd = side_of(d, vertex[t]);
-      }
+    // plane b at the vertex of u = (c, a, d) (see build_verified's far-plane tests).
+    int sd;
+    if (!ready[t] && ready[u]) {
+      sd = side_of(b, vertex[u]);
+    } else {
+      if (!make_vertex(t)) return false;
+      sd = side_of(d, vertex[t]);
     }
     if (sd <= 0) {
       diagonal_side(a, c) = static_cast<signed char>(sd);
@@ -3943,7 +3884,7 @@ bool triangulate_polygon(const Planes& planes, const PrecisePlanes& precise,
 /// triangulated or the triangles do not close up into a surface.
 DualSurface expected_surface(const Planes& planes, const PrecisePlanes& precise,
                              const KnownPoints& known, const ExpectedVertices& expected,
-                             const V3<double>& o, const IntersectOptions& options) {
+                             const V3<double>& o) {
   DualSurface s;
   const int nv = static_cast<int>(expected.begin.size()) - 1;
   std::vector<int> first(nv + 1, 0);  // each polygon's first triangle
@@ -3968,28 +3909,11 @@ DualSurface expected_surface(const Planes& planes, const PrecisePlanes& precise,
                              &s.far_side[3 * static_cast<std::size_t>(first[v])], scratch))
       ok = false;
   };
-  const bool local = options.local_quads && !expected.local.empty();
-  std::atomic<long> decided = 0, undecided = 0, mismatches = 0;
   parallel_chunks(ok ? nv : 0, 64, [&](int begin, int end) {
     RoundingGuard guard;
     PolygonScratch scratch;
-    scratch.local_normal = local ? expected.local_normal.data() : nullptr;
-    scratch.verify_local = options.verify_local;
-    for (int v = begin; v < end && ok; ++v) {
-      // (A fan without its values has NaN throughout.)
-      const double* values = local ? &expected.local[expected.begin[v]] : nullptr;
-      scratch.local = values && !std::isnan(values[0]) ? values : nullptr;
-      triangulate(v, scratch);
-    }
-    decided += scratch.local_decided;
-    undecided += scratch.local_undecided;
-    mismatches += scratch.local_mismatches;
+    for (int v = begin; v < end && ok; ++v) triangulate(v, scratch);
   });
-  if (options.counts) {
-    options.counts->local_decided += decided;
-    options.counts->local_undecided += undecided;
-    options.counts->local_mismatches += mismatches;
-  }
   if (!ok) return {};
   // Directed edges 3 t + k (corner k to k + 1 of triangle t) listed by their first plane
   // (a counting sort), each with its second plane: each edge's reverse is the one edge back
@@ -4078,7 +4002,7 @@ MaybePolytope intersect_halfspaces(const HalfSpaces& hs, const V3<double>& hint,
   const PrecisePlanes precise(planes);
   if (options.incremental && options.guess && !expected.empty()) {
     bool repaired = false;
-    DualSurface guess = expected_surface(planes, precise, known, expected, o_double, options);
+    DualSurface guess = expected_surface(planes, precise, known, expected, o_double);
     if (options.dual_filter && !guess.corner.empty())
       guess.dual = std::make_shared<const DualPoints>(dual_points(planes, o_double));
     if (auto built = build_verified(hs, planes, precise, known, std::move(guess), options, owner,

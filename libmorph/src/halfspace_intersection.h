@@ -223,12 +223,6 @@ struct RepairCounts {
   // on 32 bytes a plane), and those left to the planes' own filters and exact values.
   long dual_decided = 0;
   long dual_undecided = 0;
-  // The guess's diagonals of polygons decided on their translated planes
-  // (ExpectedVertices::local), those left to the planes, and (with
-  // IntersectOptions::verify_local) those whose sign the planes' own test gives otherwise.
-  long local_decided = 0;
-  long local_undecided = 0;
-  long local_mismatches = 0;
 };
 
 /// Options of intersect_halfspaces.
@@ -247,10 +241,6 @@ struct IntersectOptions {
   // false: the checks and repairs test the planes without their dual points' filter (tests
   // compare: the same decisions either way).
   bool dual_filter = true;
-  // false: the guess ignores ExpectedVertices::local (tests compare). verify_local: each
-  // sign it decides is also computed from the planes and compared (counts.local_mismatches).
-  bool local_quads = true;
-  bool verify_local = false;
 };
 
 /// The exact value hi + lo of each coordinate.
@@ -312,20 +302,6 @@ struct ExpectedVertices {
   // that vanish and puts in planes the guess left out that cut it (a closing of an A whose
   // facets are only nearly planar).
   bool split = true;
-  // Optional (an erosion of A over doubles whose polygons are A's vertex fans, where a
-  // fan's facets are quadrilaterals in one fixed-point frame (wide_exact.h), all moved by
-  // the same vertex b of B: a UV sphere's): per entry of `facets`, the plane's offset
-  // translated to the fan's vertex v, <N_f, p_top - v> for f's Newell normal N_f and a top
-  // corner p_top (0 where v is one; else |h_f|, the quadrilateral's height), as a double
-  // within 2^-52 of it, or NaN (the whole fan) where not known; and per half-space, N_f as
-  // doubles within 2^-52 of each component. The side of plane d at the vertex of planes
-  // a, b, c does not change when all four are translated by one vector (it is the sign of
-  // the 4 x 4 determinant of their rows (n, -offset), and a translation subtracts a
-  // combination of the other columns from the last), so such a polygon's diagonals are
-  // decided on these small, exact-to-an-ulp values (triangulate_polygon), where the planes
-  // themselves, nearly through one point, leave them to the precise stage. Empty: none.
-  std::vector<double> local;
-  std::vector<V3<double>> local_normal;
   bool empty() const { return begin.empty(); }
 };
 

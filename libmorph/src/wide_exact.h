@@ -431,17 +431,6 @@ class Normal {
     }
     return true;
   }
-  /// <n, u - v> as a double within 2^-52 of its magnitude (to_dd's hi, from the exact words:
-  /// nearest to the value but for 2^-104 of it). False for a large frame, or where to_dd
-  /// declines (a value that could leave 2^+-600), and `out` is then unchanged.
-  bool dot_double(const V3<double>& u, const V3<double>& v, double& out) const {
-    if (!frame_.small) return false;
-    RoundingGuard nearest(CGAL_FE_TONEAREST);
-    DD d;
-    if (!to_dd(dot(small_, small(u) - small(v)), 3 * frame_.unit, d)) return false;
-    out = d.hi;
-    return true;
-  }
   /// For a small frame: the words of n and of <n, u - v> with their exponents, the values
   /// that set_normal(doubling) and set_dot(doubling, u, &v) make Mpzf (set_exact makes them
   /// later, where needed). False for a large frame.
