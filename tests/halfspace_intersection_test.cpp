@@ -2126,3 +2126,48 @@ TEST_CASE("halfspace_intersection: half-spaces copy their exact values when they
   CHECK(unit.unit_denominator());
   CHECK(unit.exact_offset() == ExactN(4));
 }
+
+// An erosion of a polytope of exact triangles takes the signs that A's own convexity makes
+// certain from A (ExpectedVertices::moved_by): the orientation of each triangle of a polygon
+// one vertex of B moved, and the far-plane sign across each edge of A between two such
+// polygons of the same vertex. Each of them is the sign the tests give (verify_certified
+// makes those tests too), and the result is the one made testing them all, whether facets
+// vanish or not and wherever B's origin lies. A UV sphere's nearly planar quadrilaterals
+// certify nothing: their planes do not pass through their corners.
+TEST_CASE("halfspace_intersection: the signs a guess takes from A's convexity are the tests'") {
+  enum class Certifies { none, some, most };  // most: B has far fewer vertices than A
+  struct Case {
+    morph::Mesh A, B;
+    Certifies certifies;
+  };
+  const Case cases[] = {
+      {morph::make_icosphere(1.0, 4), morph::make_icosphere(0.25, 1), Certifies::most},
+      {morph::make_icosphere(1.0, 3), morph::test::scaled(morph::make_icosphere(1.0, 3), 0.25),
+       Certifies::some},
+      {morph::test::random_sphere_polytope(400, 11), morph::test::cube(0.3), Certifies::most},
+      {morph::test::random_sphere_polytope(300, 12),
+       morph::test::translated(morph::test::tetrahedron(0.2), {0.3, -0.2, 0.1}), Certifies::most},
+      {morph::test::random_sphere_polytope(200, 13),
+       morph::test::transformed(morph::test::random_sphere_polytope(40, 14, 0.2),
+                                morph::test::random_rotation(15)),
+       Certifies::some},
+      {morph::make_uv_sphere(1.0, 40), morph::test::cube(0.3), Certifies::none},
+  };
+  for (const Case& c : cases) {
+    const Polytope A = make_operand(c.A, "A");
+    const Polytope B = make_operand(c.B, "B");
+    CAPTURE(A.num_faces());
+    RepairCounts counts, untaken;
+    const MaybePolytope r = erode_polytope(A, B, {.counts = &counts, .verify_certified = true});
+    REQUIRE(r.polytope);
+    CHECK(difference(erode_polytope(A, B, {.counts = &untaken, .certify = false}), r) == "");
+    CHECK(untaken.certified == 0);
+    CHECK(counts.certified_wrong == 0);
+    CAPTURE(counts.certified);
+    if (c.certifies == Certifies::none) CHECK(counts.certified == 0);
+    if (c.certifies == Certifies::some) CHECK(counts.certified > 0);
+    // Every triangle's orientation but those of polygons that two vertices of B moved, and
+    // most far-plane signs: more than twice A's facets in all.
+    if (c.certifies == Certifies::most) CHECK(counts.certified > 2 * A.num_faces());
+  }
+}

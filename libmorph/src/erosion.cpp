@@ -411,6 +411,12 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
   const double ka = 1.0 / A.num_vertices(), kb = 1.0 / B.num_vertices();
   in.hint = {ca.x * ka - cb.x * kb, ca.y * ka - cb.y * kb, ca.z * ka - cb.z * kb};
   in.halfspaces = std::move(hs);
+  // Each plane through its triangle's corners exactly (the branch above for every facet):
+  // the guess's signs that A's own convexity makes certain are not tested.
+  bool exact_triangles =
+      A.given_normals.empty() && A.exact_points.empty() && B.exact_points.empty();
+  for (int f = 0; f < nf && exact_triangles; ++f) exact_triangles = A.degree(f) == 3;
+  if (expected.fans_of_operand && exact_triangles) expected.moved_by = std::move(contributing);
   in.expected = std::move(expected);
   return in;
 }
@@ -426,8 +432,9 @@ MaybePolytope erode_polytope(const Polytope& A, const Polytope& B,
   // Facet f of A is half-space f: A's fans are the polygons of the guess. The input is
   // shared with the result, whose lazy exact points (an opening) read its planes and known
   // points rather than copies.
-  const auto in = std::make_shared<const ErosionInput>(
-      erosion_input(A, B, SumOfB::no, {A.fan_begin, A.fan_face}));
+  const auto in = std::make_shared<const ErosionInput>(erosion_input(
+      A, B, SumOfB::no,
+      {.begin = A.fan_begin, .facets = A.fan_face, .fans_of_operand = true, .moved_by = {}}));
   return intersect_halfspaces(in->halfspaces, in->hint, options, in->known, in->expected, in);
 }
 

@@ -337,6 +337,9 @@ struct DualSurface {
   // triangles it left, with the same neighbours.
   bool oriented = false;
   std::vector<signed char> far_side;
+  // Empty, or per triangle of a guess: 1 where its orientation is certain (positive; see
+  // ExpectedVertices::moved_by), not tested. Read only while `oriented` is false.
+  std::vector<char> certified;
   // The planes' dual points about the interior point the candidate was built about, when
   // it has them: the first filter of the check's and the repair's tests.
   std::shared_ptr<const DualPoints> dual;
@@ -2373,6 +2376,7 @@ bool SurfaceRepair::compact() {
   }
   s_.far_side = std::move(far_side);
   s_.oriented = true;
+  s_.certified.clear();  // (numbered as the guess was)
   for (int t = 0; t < nt; ++t) {
     // (Each slot is written once, from itself or from a kept triangle beyond `kept`.)
     if (dead_[t]) continue;
@@ -2461,7 +2465,7 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
   parallel_chunks(s.oriented ? 0 : nt, 512, [&](int begin, int end) {
     RoundingGuard guard;
     for (int t = begin; t < end && ok; ++t)
-      if (!oriented(t)) ok = false;
+      if ((s.certified.empty() || !s.certified[t]) && !oriented(t)) ok = false;
   });
   if (!ok) return std::nullopt;
   // A ray from o crosses exactly one triangle: through the inside of triangle 0, and
@@ -3878,13 +3882,66 @@ bool triangulate_polygon(const Planes& planes, const PrecisePlanes& precise,
   return true;
 }
 
+/// The signs of a guess that A's own convexity makes certain (ExpectedVertices::moved_by,
+/// where the argument is): each triangle of a polygon whose planes one vertex b of B moved is
+/// positively oriented (s.certified), and the far plane across its edge to a triangle of
+/// another such polygon of the same b is strictly above its vertex (far side -1). `first`:
+/// each polygon's first triangle. With options.verify_certified each is also tested.
+void certify(const Planes& planes, const PrecisePlanes& precise, const KnownPoints& known,
+             const ExpectedVertices& expected, const std::vector<int>& first, DualSurface& s,
+             const IntersectOptions& options) {
+  const int nv = static_cast<int>(first.size()) - 1, nt = static_cast<int>(s.corner.size());
+  const std::vector<int>& moved_by = expected.moved_by;
+  std::vector<int> by(nt, -1);  // per triangle: the one vertex of B moving its polygon, or -1
+  parallel_chunks(nv, 256, [&](int begin, int end) {
+    for (int v = begin; v < end; ++v) {
+      const int b = moved_by[expected.facets[expected.begin[v]]];
+      bool one = true;
+      for (int j = expected.begin[v] + 1; j < expected.begin[v + 1] && one; ++j)
+        one = moved_by[expected.facets[j]] == b;
+      if (one) std::fill(by.begin() + first[v], by.begin() + first[v + 1], b);
+    }
+  });
+  s.certified.assign(nt, 0);
+  std::atomic<long> certified = 0, wrong = 0;
+  parallel_chunks(nt, 1024, [&](int begin, int end) {
+    RoundingGuard guard;
+    long made = 0, differ = 0;
+    for (int t = begin; t < end; ++t) {
+      if (by[t] < 0) continue;
+      const auto& c = s.corner[t];
+      s.certified[t] = 1;
+      ++made;
+      if (options.verify_certified && det_sign(planes, precise, c[0], c[1], c[2]) <= 0) ++differ;
+      for (int k = 0; k < 3; ++k) {
+        // (Set: a diagonal of t's own polygon; 2: a side, with a polygon across.)
+        if (s.far_side[3 * t + k] != 2 || by[s.across[t][k]] != by[t]) continue;
+        s.far_side[3 * t + k] = -1;
+        ++made;
+        if (options.verify_certified) {
+          const int far = s.far_corner(t, k);
+          HVertex v = independent_vertex_of(planes, c, known);
+          if (far < 0 || known_through(known, far, v) || side(planes, precise, far, v) >= 0)
+            ++differ;
+        }
+      }
+    }
+    certified += made;
+    wrong += differ;
+  });
+  if (options.counts) {
+    options.counts->certified += certified;
+    options.counts->certified_wrong += wrong;
+  }
+}
+
 /// The dual surface of an expected result: each expected vertex's polygon of planes
 /// triangulated (triangulate_polygon, in parallel; counter-clockwise seen from outside, as
 /// the dual hull's), joined across shared edges. Empty when a polygon cannot be
 /// triangulated or the triangles do not close up into a surface.
 DualSurface expected_surface(const Planes& planes, const PrecisePlanes& precise,
                              const KnownPoints& known, const ExpectedVertices& expected,
-                             const V3<double>& o) {
+                             const V3<double>& o, const IntersectOptions& options) {
   DualSurface s;
   const int nv = static_cast<int>(expected.begin.size()) - 1;
   std::vector<int> first(nv + 1, 0);  // each polygon's first triangle
@@ -3967,6 +4024,8 @@ DualSurface expected_surface(const Planes& planes, const PrecisePlanes& precise,
   if (!ok) return {};
   for (const auto& u : s.across)
     if (u[0] < 0 || u[1] < 0 || u[2] < 0) return {};
+  if (!expected.moved_by.empty() && options.certify)
+    certify(planes, precise, known, expected, first, s, options);
   return s;
 }
 
@@ -4002,7 +4061,7 @@ MaybePolytope intersect_halfspaces(const HalfSpaces& hs, const V3<double>& hint,
   const PrecisePlanes precise(planes);
   if (options.incremental && options.guess && !expected.empty()) {
     bool repaired = false;
-    DualSurface guess = expected_surface(planes, precise, known, expected, o_double);
+    DualSurface guess = expected_surface(planes, precise, known, expected, o_double, options);
     if (options.dual_filter && !guess.corner.empty())
       guess.dual = std::make_shared<const DualPoints>(dual_points(planes, o_double));
     if (auto built = build_verified(hs, planes, precise, known, std::move(guess), options, owner,

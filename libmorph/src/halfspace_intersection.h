@@ -223,6 +223,11 @@ struct RepairCounts {
   // on 32 bytes a plane), and those left to the planes' own filters and exact values.
   long dual_decided = 0;
   long dual_undecided = 0;
+  // A guess's signs certain without a test (ExpectedVertices::moved_by): triangle
+  // orientations and far-plane signs; with IntersectOptions::verify_certified, those that
+  // the tests would have given otherwise (none: a test fails when not).
+  long certified = 0;
+  long certified_wrong = 0;
 };
 
 /// Options of intersect_halfspaces.
@@ -241,6 +246,11 @@ struct IntersectOptions {
   // false: the checks and repairs test the planes without their dual points' filter (tests
   // compare: the same decisions either way).
   bool dual_filter = true;
+  // false: the guess's signs that ExpectedVertices::moved_by makes certain are tested like
+  // any other (tests compare). verify_certified: they are skipped, and also tested, each
+  // different sign counted (RepairCounts::certified_wrong; tests).
+  bool certify = true;
+  bool verify_certified = false;
 };
 
 /// The exact value hi + lo of each coordinate.
@@ -302,6 +312,17 @@ struct ExpectedVertices {
   // that vanish and puts in planes the guess left out that cut it (a closing of an A whose
   // facets are only nearly planar).
   bool split = true;
+  // Set by erode_polytope: the polygons are the vertex fans of the eroded polytope A itself
+  // (polygon v: the facets around A's vertex v), half-space f its facet f.
+  bool fans_of_operand = false;
+  // Empty, or per half-space the vertex of B that moved it, set by the erosion when every
+  // facet of A is a triangle whose corners lie exactly on its plane (so every edge of the
+  // canonical A is exactly strictly convex) and the polygons are A's fans. Then what a
+  // polygon whose planes one vertex b moved and its neighbours share with A is certain, not
+  // tested: its triangles' vertex is v - b exactly, their normals turn like A's (positive
+  // orientation), and across an edge of A to another such polygon of the same b the far
+  // plane lies strictly above that vertex (A's vertex v strictly below every facet not at v).
+  std::vector<int> moved_by;
   bool empty() const { return begin.empty(); }
 };
 
