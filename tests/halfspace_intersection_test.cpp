@@ -2171,3 +2171,51 @@ TEST_CASE("halfspace_intersection: the signs a guess takes from A's convexity ar
     if (c.certifies == Certifies::most) CHECK(counts.certified > 2 * A.num_faces());
   }
 }
+
+// The planes a repair's 3-1 flips take off the surface lie strictly inside the result (see
+// DualSurface::inside): the check does not walk to them, and with verify_certified it does,
+// finding each strictly below the result's highest vertex along its normal. Here where
+// many vanish (a UV sphere's rows of quadrilaterals, an icosphere's facets near the arcs of
+// a small element's Gauss map), and on a cube with a chamfered edge whose chamfer an
+// octahedron of radius r makes vanish (chamfer width c < r) or leaves touching the result
+// along an edge (c = r: a plane through two vertices, not strictly inside).
+TEST_CASE("halfspace_intersection: the planes a 3-1 flip takes off stay strictly inside") {
+  const auto chamfered = [](double c) {
+    std::vector<morph::Point> p;
+    for (double z : {-1.0, 1.0}) {
+      for (const auto& [x, y] : {std::pair(-1.0, -1.0), std::pair(1.0, -1.0), std::pair(-1.0, 1.0),
+                                 std::pair(1.0, 1.0 - c), std::pair(1.0 - c, 1.0)})
+        p.push_back({x, y, z});
+    }
+    return morph::test::convex_hull_mesh(p);
+  };
+  struct Case {
+    morph::Mesh A, B;
+    bool removes;
+  };
+  const Case cases[] = {
+      {morph::make_uv_sphere(1.0, 40), morph::test::cube(0.3), true},
+      {morph::make_icosphere(1.0, 4), morph::make_icosphere(0.25, 1), true},
+      {chamfered(0.125), morph::test::octahedron(0.25), false},
+      {chamfered(0.25), morph::test::octahedron(0.25), false},
+  };
+  for (const Case& c : cases) {
+    const Polytope A = make_operand(c.A, "A");
+    const Polytope B = make_operand(c.B, "B");
+    CAPTURE(A.num_faces());
+    RepairCounts skipped, walked;
+    const MaybePolytope r = erode_polytope(A, B, {.counts = &skipped});
+    REQUIRE(r.polytope);
+    CHECK(difference(erode_polytope(A, B, {.guess = false}), r) == "");
+    CHECK(difference(erode_polytope(A, B, {.counts = &walked, .verify_certified = true}), r) == "");
+    CHECK(walked.certified_wrong == 0);
+    CHECK(skipped.certified_inside == skipped.removals);
+    CHECK(skipped.check_planes + skipped.certified_inside == walked.check_planes);
+    if (c.removes) CHECK(skipped.certified_inside > 0);
+  }
+  // The chamfer vanishes, or touches the result along an edge.
+  const Polytope B = make_operand(morph::test::octahedron(0.25), "B");
+  CHECK(erode_polytope(make_operand(chamfered(0.125), "A"), B).polytope->num_faces() == 6);
+  CHECK(erode_polytope(make_operand(chamfered(0.25), "A"), B).polytope->num_faces() == 6);
+  CHECK(erode_polytope(make_operand(chamfered(0.375), "A"), B).polytope->num_faces() == 7);
+}

@@ -340,6 +340,12 @@ struct DualSurface {
   // Empty, or per triangle of a guess: 1 where its orientation is certain (positive; see
   // ExpectedVertices::moved_by), not tested. Read only while `oriented` is false.
   std::vector<char> certified;
+  // Empty, or per plane: 1 where a repair's 3-1 flip took it off the surface. Its dual
+  // point then lay strictly beneath its three neighbours' triangle, in that triangle's cone:
+  // strictly inside the hull of o and dual points that end on the surface or inside its
+  // hull, and o is strictly inside that hull; so its plane neither cuts nor touches the
+  // result, and the check does not walk to it (see SurfaceRepair::remove).
+  std::vector<char> inside;
   // The planes' dual points about the interior point the candidate was built about, when
   // it has them: the first filter of the check's and the repair's tests.
   std::shared_ptr<const DualPoints> dual;
@@ -1942,7 +1948,11 @@ bool SurfaceRepair::remove(int t, int i) {
   if (!positive(y, z, d)) return false;
   if (!relink(Z, d, z, t) || !relink(Y, y, d, t)) return false;
   s_.near[x] = t;  // x's dual point lies beneath t
+  // (Strictly: the reflex edge's test is x's, and the fan of three positive triangles about
+  // x covers the cone of y, z, d once, x's dual point in it.)
+  s_.inside[x] = 1;
   ++counts_.removals;
+  ++counts_.certified_inside;
   make_triangle(t, {y, z, d});
   s_.across[t] = {X, Z, Y};
   kill(u);
@@ -2240,6 +2250,7 @@ bool SurfaceRepair::run(const std::vector<std::pair<int, int>>& reflex) {
   RoundingGuard guard;
   const int nt = size();
   s_.near.assign(planes_.size(), -1);
+  s_.inside.assign(planes_.size(), 0);
   for (auto it = reflex.rbegin(); it != reflex.rend(); ++it)
     queue_.push_back(
         {it->first, s_.corner[it->first][it->second], s_.corner[it->first][next(it->second)]});
@@ -2831,9 +2842,14 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
   // vertices of A), the climb starts there and usually ends at once; where it does not, at
   // the chunk's last vertex. The result does not depend on the start. Two vertices both
   // known on the plane compare equal without arithmetic.
+  // (Not those a repair's 3-1 flips took off, strictly inside: see DualSurface::inside;
+  // with options.verify_certified, those too, each that is not strictly inside counted.)
   std::vector<int> others;
+  const auto certified_inside = [&](int p) { return !s.inside.empty() && s.inside[p]; };
   for (int p = 0; p < n; ++p)
-    if (some_triangle[p] < 0) others.push_back(p);
+    if (some_triangle[p] < 0 && (options.verify_certified || !certified_inside(p)))
+      others.push_back(p);
+  std::atomic<long> inside_wrong = 0;
   std::vector<int> vertex_at_point;  // the vertex that is known point k, or -1
   if (!known.empty() && !others.empty()) {
     vertex_at_point.assign(known.size(), -1);
@@ -2899,6 +2915,7 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
       // (After a walk, u is the vertex of the triangle it ended on: the dual points first.)
       int sd = u_on ? 0 : walked ? dual_side(s.dual.get(), s.corner[start], i) : 2;
       if (sd == 2) sd = side_of(i, u);
+      if (sd >= 0 && certified_inside(i)) ++inside_wrong;
       if (sd > 0) {
         if (can_repair)
           cut[j] = u;
@@ -2921,6 +2938,7 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
   });
   counts.check_planes += static_cast<long>(others.size());
   counts.check_steps += check_steps;
+  counts.certified_wrong += inside_wrong;
   if (!ok) return std::nullopt;
   if (std::any_of(cut.begin(), cut.end(), [](int v) { return v >= 0; })) {
     // Planes the guess left out that cut it (a closing of a UV sphere, whose result is not

@@ -227,6 +227,7 @@ struct RepairCounts {
   // orientations and far-plane signs; with IntersectOptions::verify_certified, those that
   // the tests would have given otherwise (none: a test fails when not).
   long certified = 0;
+  long certified_inside = 0;  // planes a 3-1 flip took off, not walked to (DualSurface::inside)
   long certified_wrong = 0;
 };
 
@@ -248,7 +249,8 @@ struct IntersectOptions {
   bool dual_filter = true;
   // false: the guess's signs that ExpectedVertices::moved_by makes certain are tested like
   // any other (tests compare). verify_certified: they are skipped, and also tested, each
-  // different sign counted (RepairCounts::certified_wrong; tests).
+  // different sign counted (RepairCounts::certified_wrong; tests); so are the planes a
+  // repair's 3-1 flips took off (always certain, not walked to: DualSurface::inside).
   bool certify = true;
   bool verify_certified = false;
 };
