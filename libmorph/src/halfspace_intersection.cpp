@@ -3922,25 +3922,29 @@ void certify(const Planes& planes, const PrecisePlanes& precise, const KnownPoin
   });
   s.certified.assign(nt, 0);
   std::atomic<long> certified = 0, wrong = 0;
-  parallel_chunks(nt, 1024, [&](int begin, int end) {
+  parallel_chunks(nv, 256, [&](int begin, int end) {
     RoundingGuard guard;
     long made = 0, differ = 0;
-    for (int t = begin; t < end; ++t) {
-      if (by[t] < 0) continue;
-      const auto& c = s.corner[t];
-      s.certified[t] = 1;
-      ++made;
-      if (options.verify_certified && det_sign(planes, precise, c[0], c[1], c[2]) <= 0) ++differ;
-      for (int k = 0; k < 3; ++k) {
-        // (Set: a diagonal of t's own polygon; 2: a side, with a polygon across.)
-        if (s.far_side[3 * t + k] != 2 || by[s.across[t][k]] != by[t]) continue;
-        s.far_side[3 * t + k] = -1;
+    for (int v = begin; v < end; ++v) {
+      if (by[first[v]] < 0) continue;
+      for (int t = first[v]; t < first[v + 1]; ++t) {
+        const auto& c = s.corner[t];
+        s.certified[t] = 1;
         ++made;
-        if (options.verify_certified) {
-          const int far = s.far_corner(t, k);
-          HVertex v = independent_vertex_of(planes, c, known);
-          if (far < 0 || known_through(known, far, v) || side(planes, precise, far, v) >= 0)
-            ++differ;
+        if (options.verify_certified && det_sign(planes, precise, c[0], c[1], c[2]) <= 0) ++differ;
+        for (int k = 0; k < 3; ++k) {
+          // Only a side of the polygon, untested (far side 2), with the same b across.
+          const int u = s.across[t][k];
+          if (s.far_side[3 * t + k] != 2 || (u >= first[v] && u < first[v + 1]) || by[u] != by[t])
+            continue;
+          s.far_side[3 * t + k] = -1;
+          ++made;
+          if (options.verify_certified) {
+            const int far = s.far_corner(t, k);
+            HVertex x = independent_vertex_of(planes, c, known);
+            if (far < 0 || known_through(known, far, x) || side(planes, precise, far, x) >= 0)
+              ++differ;
+          }
         }
       }
     }
