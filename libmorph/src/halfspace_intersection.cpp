@@ -338,7 +338,7 @@ struct DualSurface {
   bool oriented = false;
   std::vector<signed char> far_side;
   // Empty, or per triangle of a guess: 1 where its orientation is certain (positive; see
-  // ExpectedVertices::moved_by), not tested. Read only while `oriented` is false.
+  // ExpectedVertices::fans_of_operand), not tested. Read only while `oriented` is false.
   std::vector<char> certified;
   // Empty, or per plane: 1 where a repair's 3-1 flip took it off the surface. Its dual
   // point then lay strictly beneath its three neighbours' triangle, in that triangle's cone:
@@ -3900,38 +3900,39 @@ bool triangulate_polygon(const Planes& planes, const PrecisePlanes& precise,
   return true;
 }
 
-/// The signs of a guess that A's own convexity makes certain (ExpectedVertices::moved_by,
-/// where the argument is): each triangle of a polygon whose planes one vertex b of B moved is
-/// positively oriented (s.certified), and the far plane across its edge to a triangle of
-/// another such polygon of the same b is strictly above its vertex (far side -1). `first`:
-/// each polygon's first triangle. With options.verify_certified each is also tested.
+/// The signs of a guess of A's own fans that A's convexity makes certain (see
+/// ExpectedVertices::fans_of_operand and moved_by, where the arguments are): every triangle
+/// is positively oriented (s.certified), and where moved_by is given, the far plane across a
+/// side of a polygon whose planes one vertex b of B moved, to a triangle of another such
+/// polygon of the same b, is strictly above its vertex (far side -1). `first`: each
+/// polygon's first triangle. With options.verify_certified each is also tested.
 void certify(const Planes& planes, const PrecisePlanes& precise, const KnownPoints& known,
              const ExpectedVertices& expected, const std::vector<int>& first, DualSurface& s,
              const IntersectOptions& options) {
   const int nv = static_cast<int>(first.size()) - 1, nt = static_cast<int>(s.corner.size());
   const std::vector<int>& moved_by = expected.moved_by;
-  std::vector<int> by(nt, -1);  // per triangle: the one vertex of B moving its polygon, or -1
-  parallel_chunks(nv, 256, [&](int begin, int end) {
-    for (int v = begin; v < end; ++v) {
-      const int b = moved_by[expected.facets[expected.begin[v]]];
-      bool one = true;
-      for (int j = expected.begin[v] + 1; j < expected.begin[v + 1] && one; ++j)
-        one = moved_by[expected.facets[j]] == b;
-      if (one) std::fill(by.begin() + first[v], by.begin() + first[v + 1], b);
-    }
-  });
-  s.certified.assign(nt, 0);
-  std::atomic<long> certified = 0, wrong = 0;
+  // Per triangle: the one vertex of B moving its polygon, or -1 (all -1 without moved_by).
+  std::vector<int> by(nt, -1);
+  if (!moved_by.empty())
+    parallel_chunks(nv, 256, [&](int begin, int end) {
+      for (int v = begin; v < end; ++v) {
+        const int b = moved_by[expected.facets[expected.begin[v]]];
+        bool one = true;
+        for (int j = expected.begin[v] + 1; j < expected.begin[v + 1] && one; ++j)
+          one = moved_by[expected.facets[j]] == b;
+        if (one) std::fill(by.begin() + first[v], by.begin() + first[v + 1], b);
+      }
+    });
+  s.certified.assign(nt, 1);
+  std::atomic<long> certified = nt, wrong = 0;
   parallel_chunks(nv, 256, [&](int begin, int end) {
     RoundingGuard guard;
     long made = 0, differ = 0;
     for (int v = begin; v < end; ++v) {
-      if (by[first[v]] < 0) continue;
       for (int t = first[v]; t < first[v + 1]; ++t) {
         const auto& c = s.corner[t];
-        s.certified[t] = 1;
-        ++made;
         if (options.verify_certified && det_sign(planes, precise, c[0], c[1], c[2]) <= 0) ++differ;
+        if (by[t] < 0) continue;
         for (int k = 0; k < 3; ++k) {
           // Only a side of the polygon, untested (far side 2), with the same b across.
           const int u = s.across[t][k];
@@ -4046,7 +4047,7 @@ DualSurface expected_surface(const Planes& planes, const PrecisePlanes& precise,
   if (!ok) return {};
   for (const auto& u : s.across)
     if (u[0] < 0 || u[1] < 0 || u[2] < 0) return {};
-  if (!expected.moved_by.empty() && options.certify)
+  if (expected.fans_of_operand && options.certify)
     certify(planes, precise, known, expected, first, s, options);
   return s;
 }

@@ -223,7 +223,7 @@ struct RepairCounts {
   // on 32 bytes a plane), and those left to the planes' own filters and exact values.
   long dual_decided = 0;
   long dual_undecided = 0;
-  // A guess's signs certain without a test (ExpectedVertices::moved_by): triangle
+  // A guess's signs certain without a test (ExpectedVertices::fans_of_operand, moved_by): triangle
   // orientations and far-plane signs; with IntersectOptions::verify_certified, those that
   // the tests would have given otherwise (none: a test fails when not).
   long certified = 0;
@@ -247,7 +247,7 @@ struct IntersectOptions {
   // false: the checks and repairs test the planes without their dual points' filter (tests
   // compare: the same decisions either way).
   bool dual_filter = true;
-  // false: the guess's signs that ExpectedVertices::moved_by makes certain are tested like
+  // false: the guess's signs that ExpectedVertices makes certain are tested like
   // any other (tests compare). verify_certified: they are skipped, and also tested, each
   // different sign counted (RepairCounts::certified_wrong; tests); so are the planes a
   // repair's 3-1 flips took off (always certain, not walked to: DualSurface::inside).
@@ -315,15 +315,18 @@ struct ExpectedVertices {
   // facets are only nearly planar).
   bool split = true;
   // Set by erode_polytope: the polygons are the vertex fans of the eroded polytope A itself
-  // (polygon v: the facets around A's vertex v), half-space f its facet f.
+  // (polygon v: the facets around A's vertex v), half-space f its facet f, whose normal is
+  // A's facet normal (times a positive factor). Every triangle of a polygon is then
+  // positively oriented, certain and not tested: its normals are three of a strictly convex
+  // spherical polygon (A's Gauss map at v) in its counter-clockwise order.
   bool fans_of_operand = false;
   // Empty, or per half-space the vertex of B that moved it, set by the erosion when every
   // facet of A is a triangle whose corners lie exactly on its plane (so every edge of the
-  // canonical A is exactly strictly convex) and the polygons are A's fans. Then what a
-  // polygon whose planes one vertex b moved and its neighbours share with A is certain, not
-  // tested: its triangles' vertex is v - b exactly, their normals turn like A's (positive
-  // orientation), and across an edge of A to another such polygon of the same b the far
-  // plane lies strictly above that vertex (A's vertex v strictly below every facet not at v).
+  // canonical A is exactly strictly convex) and the polygons are A's fans. Then a polygon
+  // whose planes one vertex b moved is A's vertex v moved: its triangles' vertex is v - b
+  // exactly, and across an edge of A to another such polygon of the same b the far plane lies
+  // strictly above that vertex (A's vertex v strictly below every facet not at v): certain,
+  // not tested.
   std::vector<int> moved_by;
   bool empty() const { return begin.empty(); }
 };
