@@ -331,15 +331,13 @@ struct DualSurface {
   // Empty, or per plane: a triangle near the plane's dual point, for one that is not on the
   // surface (removed by a repair), where the check's climb starts; -1 where none is known.
   std::vector<int> near;
-  // Set by a repair: every triangle is known positively oriented. far_side (3 per
-  // triangle, or empty): the check's far-plane signs where known, else 2; a guess knows
-  // those of its polygons' diagonals (triangulate_polygon), a repair those of the
-  // triangles it left, with the same neighbours.
+  // Set by a repair, or for a guess of A's own fans (certify): every triangle is known
+  // positively oriented. far_side (3 per triangle, or empty): the check's far-plane signs
+  // where known, else 2; a guess knows those of its polygons' diagonals
+  // (triangulate_polygon), a repair those of the triangles it left, with the same
+  // neighbours.
   bool oriented = false;
   std::vector<signed char> far_side;
-  // Empty, or per triangle of a guess: 1 where its orientation is certain (positive; see
-  // ExpectedVertices::fans_of_operand), not tested. Read only while `oriented` is false.
-  std::vector<char> certified;
   // Empty, or per plane: 1 where a repair's 3-1 flip took it off the surface. Its dual
   // point then lay strictly beneath its three neighbours' triangle, in that triangle's cone:
   // strictly inside the hull of o and dual points that end on the surface or inside its
@@ -1952,7 +1950,6 @@ bool SurfaceRepair::remove(int t, int i) {
   // x covers the cone of y, z, d once, x's dual point in it.)
   s_.inside[x] = 1;
   ++counts_.removals;
-  ++counts_.certified_inside;
   make_triangle(t, {y, z, d});
   s_.across[t] = {X, Z, Y};
   kill(u);
@@ -2387,7 +2384,6 @@ bool SurfaceRepair::compact() {
   }
   s_.far_side = std::move(far_side);
   s_.oriented = true;
-  s_.certified.clear();  // (numbered as the guess was)
   for (int t = 0; t < nt; ++t) {
     // (Each slot is written once, from itself or from a kept triangle beyond `kept`.)
     if (dead_[t]) continue;
@@ -2476,7 +2472,7 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
   parallel_chunks(s.oriented ? 0 : nt, 512, [&](int begin, int end) {
     RoundingGuard guard;
     for (int t = begin; t < end && ok; ++t)
-      if ((s.certified.empty() || !s.certified[t]) && !oriented(t)) ok = false;
+      if (!oriented(t)) ok = false;
   });
   if (!ok) return std::nullopt;
   // A ray from o crosses exactly one triangle: through the inside of triangle 0, and
@@ -3902,7 +3898,7 @@ bool triangulate_polygon(const Planes& planes, const PrecisePlanes& precise,
 
 /// The signs of a guess of A's own fans that A's convexity makes certain (see
 /// ExpectedVertices::fans_of_operand and moved_by, where the arguments are): every triangle
-/// is positively oriented (s.certified), and where moved_by is given, the far plane across a
+/// is positively oriented (s.oriented), and where moved_by is given, the far plane across a
 /// side of a polygon whose planes one vertex b of B moved, to a triangle of another such
 /// polygon of the same b, is strictly above its vertex (far side -1). `first`: each
 /// polygon's first triangle. With options.verify_certified each is also tested.
@@ -3911,9 +3907,9 @@ void certify(const Planes& planes, const PrecisePlanes& precise, const KnownPoin
              const IntersectOptions& options) {
   const int nv = static_cast<int>(first.size()) - 1, nt = static_cast<int>(s.corner.size());
   const std::vector<int>& moved_by = expected.moved_by;
-  // Per triangle: the one vertex of B moving its polygon, or -1 (all -1 without moved_by).
-  std::vector<int> by(nt, -1);
-  if (!moved_by.empty())
+  // Per triangle: the one vertex of B moving its polygon, or -1 (none without moved_by).
+  std::vector<int> by(moved_by.empty() ? 0 : nt, -1);
+  if (!by.empty())
     parallel_chunks(nv, 256, [&](int begin, int end) {
       for (int v = begin; v < end; ++v) {
         const int b = moved_by[expected.facets[expected.begin[v]]];
@@ -3923,16 +3919,16 @@ void certify(const Planes& planes, const PrecisePlanes& precise, const KnownPoin
         if (one) std::fill(by.begin() + first[v], by.begin() + first[v + 1], b);
       }
     });
-  s.certified.assign(nt, 1);
+  s.oriented = true;
   std::atomic<long> certified = nt, wrong = 0;
-  parallel_chunks(nv, 256, [&](int begin, int end) {
+  parallel_chunks(by.empty() && !options.verify_certified ? 0 : nv, 256, [&](int begin, int end) {
     RoundingGuard guard;
     long made = 0, differ = 0;
     for (int v = begin; v < end; ++v) {
       for (int t = first[v]; t < first[v + 1]; ++t) {
         const auto& c = s.corner[t];
         if (options.verify_certified && det_sign(planes, precise, c[0], c[1], c[2]) <= 0) ++differ;
-        if (by[t] < 0) continue;
+        if (by.empty() || by[t] < 0) continue;
         for (int k = 0; k < 3; ++k) {
           // Only a side of the polygon, untested (far side 2), with the same b across.
           const int u = s.across[t][k];

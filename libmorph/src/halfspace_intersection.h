@@ -223,11 +223,11 @@ struct RepairCounts {
   // on 32 bytes a plane), and those left to the planes' own filters and exact values.
   long dual_decided = 0;
   long dual_undecided = 0;
-  // A guess's signs certain without a test (ExpectedVertices::fans_of_operand, moved_by): triangle
-  // orientations and far-plane signs; with IntersectOptions::verify_certified, those that
-  // the tests would have given otherwise (none: a test fails when not).
+  // A guess's signs taken without a test (ExpectedVertices::fans_of_operand, moved_by):
+  // triangle orientations and far-plane signs. With IntersectOptions::verify_certified, the
+  // signs taken, and planes a repair's 3-1 flips took off (not walked to), that the tests
+  // then made found otherwise (none, or the argument is wrong).
   long certified = 0;
-  long certified_inside = 0;  // planes a 3-1 flip took off, not walked to (DualSurface::inside)
   long certified_wrong = 0;
 };
 
