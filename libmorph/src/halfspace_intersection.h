@@ -388,7 +388,9 @@ bool round_precise_sum(const DD& X, double error, const DD& W, double w_error, d
 /// The facets of A through a vertex v moved by a vertex b of B (one that attains h_B(N_f))
 /// all pass through v - b: these incidences are passed on as KnownPoints.
 /// A's vertices are the expected result (ExpectedVertices): when B is small against A's
-/// features no facet vanishes, and the hull is not needed.
+/// features no facet vanishes, and the hull is not needed. The guess's triangles take their
+/// orientation from A's Gauss map turning strictly at every vertex, as every polytope here
+/// does (an operand's is checked; an exact one's facets have no straight corners).
 MaybePolytope erode_polytope(const Polytope& A, const Polytope& B,
                              const IntersectOptions& options = {});
 
