@@ -413,9 +413,10 @@ ErosionInput erosion_input(const Polytope& A, const Polytope& B, SumOfB sum_of_b
   in.halfspaces = std::move(hs);
   // Each plane through its triangle's corners exactly (the branch above for every facet):
   // the guess's signs that A's own convexity makes certain are not tested.
-  bool exact_triangles =
-      A.given_normals.empty() && A.exact_points.empty() && B.exact_points.empty();
-  for (int f = 0; f < nf && exact_triangles; ++f) exact_triangles = A.degree(f) == 3;
+  // (Only triangles: three corners a facet, as check_gauss_map tells them.)
+  const bool exact_triangles = A.given_normals.empty() && A.exact_points.empty() &&
+                               B.exact_points.empty() &&
+                               A.corner_vertex.size() == 3 * static_cast<std::size_t>(nf);
   if (expected.fans_of_operand && exact_triangles) expected.moved_by = std::move(contributing);
   in.expected = std::move(expected);
   return in;
