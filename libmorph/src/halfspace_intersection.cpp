@@ -261,9 +261,9 @@ struct ExactCoordinates {
 /// of three of the planes. The exact coordinates are computed only where the filters
 /// (intervals, then double-double) cannot decide, or for a polytope chained further.
 struct HVertex {
-  // User-provided: a value-initialised HVertex (a surface's `vertex`, resized by the
-  // thousand) is then built by its member initialisers alone, not first zeroed whole
-  // (rep stos per vertex: up to 1.6% of an erosion).
+  // User-provided: a value-initialised HVertex (VertexStore::add_range's, by the thousand)
+  // is then built by its member initialisers alone, not first zeroed whole (rep stos per
+  // vertex: up to 1.6% of an erosion).
   HVertex() {}
   std::array<int, 3> planes{};
   int known = -1;  // the known point it is (KnownPoints), if any
@@ -305,6 +305,110 @@ struct HVertex {
 /// Vertices by the hundred thousand, made afresh for each intersection (huge_pages.h).
 using HVertices = std::vector<HVertex, HugePageAllocator<HVertex>>;
 
+/// The vertices a candidate surface has made, each at a stable index (a triangle keeps the
+/// index of its own: DualSurface::slot). Most triangles never need theirs: a guess of an
+/// icosphere of 327,680 facets eroded by a small icosphere makes 19,456 of its 655,356
+/// triangles' vertices, where one per triangle mapped 136 MB whose first touch (page
+/// zeroing) was a quarter of the erosion's time on one run. Storage grows in segments
+/// that double (256 vertices, then 256, 512, ...; the large ones huge_pages.h's), made
+/// when first needed and never moved, so a reference stays valid while others are added.
+/// `add` and `add_range` may run on several threads at once on a store that `reserve`d
+/// room for them beforehand (on one thread); otherwise one thread at a time. Released
+/// indices are reused by `add_reusing` (one thread).
+class VertexStore {
+ public:
+  VertexStore() = default;
+  VertexStore(const VertexStore&) = delete;
+  VertexStore& operator=(const VertexStore&) = delete;
+  VertexStore(VertexStore&& o) noexcept
+      : segment_(std::move(o.segment_)),
+        size_(o.size_.load(std::memory_order_relaxed)),
+        free_(std::move(o.free_)) {
+    o.segment_.clear();
+    o.size_ = 0;
+  }
+  VertexStore& operator=(VertexStore&& o) noexcept {
+    if (this != &o) {
+      clear();
+      segment_ = std::move(o.segment_);
+      size_ = o.size_.load(std::memory_order_relaxed);
+      free_ = std::move(o.free_);
+      o.segment_.clear();
+      o.size_ = 0;
+    }
+    return *this;
+  }
+  ~VertexStore() { clear(); }
+
+  int size() const { return static_cast<int>(size_.load(std::memory_order_relaxed)); }
+  HVertex& operator[](int i) { return at(static_cast<std::size_t>(i)); }
+  const HVertex& operator[](int i) const { return const_cast<VertexStore&>(*this).at(i); }
+
+  /// Room for `count` more vertices, so that adding them needs no new segment (one thread).
+  void reserve(std::size_t count) { make_segments(size_.load() + count); }
+  /// `count` new default vertices in a row; the first's index.
+  int add_range(int count) {
+    const std::size_t first = size_.fetch_add(count, std::memory_order_relaxed);
+    make_segments(first + count);  // (nothing to do after `reserve`)
+    for (std::size_t i = first; i < first + count; ++i) new (&at(i)) HVertex();
+    return static_cast<int>(first);
+  }
+  int add(HVertex&& v) {
+    const int i = add_range(1);
+    (*this)[i] = std::move(v);
+    return i;
+  }
+  /// Index i no longer used (one thread): add_reusing may give it out again.
+  void release(int i) { free_.push_back(i); }
+  int add_reusing(HVertex&& v) {
+    if (free_.empty()) return add(std::move(v));
+    const int i = free_.back();
+    free_.pop_back();
+    (*this)[i] = std::move(v);
+    return i;
+  }
+  /// No index is given out again (a store handed to the polytope's exact points).
+  void forget_released() { free_.clear(); }
+
+ private:
+  static constexpr int kBaseBits = 8;  // the first segments' 256 vertices
+  using Allocator = HugePageAllocator<HVertex>;
+  // Segment k >= 1 holds indices [256 * 2^(k-1), 256 * 2^k), segment 0 the first 256.
+  static int segment_of(std::size_t i) {
+    const std::size_t q = i >> kBaseBits;
+    return q == 0 ? 0 : 64 - __builtin_clzll(q);
+  }
+  static std::size_t segment_start(int k) {
+    return k == 0 ? 0 : std::size_t{1} << (kBaseBits + k - 1);
+  }
+  static std::size_t segment_size(int k) {
+    return std::size_t{1} << (k == 0 ? kBaseBits : kBaseBits + k - 1);
+  }
+  HVertex& at(std::size_t i) {
+    const int k = segment_of(i);
+    return segment_[k][i - segment_start(k)];
+  }
+  void make_segments(std::size_t count) {
+    if (count == 0) return;
+    const int last = segment_of(count - 1);
+    while (static_cast<int>(segment_.size()) <= last)
+      segment_.push_back(Allocator().allocate(segment_size(static_cast<int>(segment_.size()))));
+  }
+  void clear() {
+    const std::size_t n = size_.load(std::memory_order_relaxed);
+    for (std::size_t i = 0; i < n; ++i) at(i).~HVertex();
+    for (std::size_t k = 0; k < segment_.size(); ++k)
+      Allocator().deallocate(segment_[k], segment_size(static_cast<int>(k)));
+    segment_.clear();
+    size_ = 0;
+    free_.clear();
+  }
+
+  std::vector<HVertex*> segment_;
+  std::atomic<std::size_t> size_{0};
+  std::vector<int> free_;
+};
+
 /// The planes' dual points about an interior point o, p = n / (d - <n, o>), in doubles, each
 /// coordinate within `error` of the exact one (negative: no copy): a filter for the tests
 /// of four planes that flips make. The side of plane i at the vertex of planes a, b, c is
@@ -322,12 +426,14 @@ using DualPoints = std::vector<DualPoint>;  // (one array: one cache line a poin
 /// A candidate dual hull: triangles over plane indices, counter-clockwise seen from
 /// outside, and the triangle across each edge (edge k runs from corner k to corner k + 1).
 /// The vertex of a triangle's three planes (vertex_of, in the corners' order) may come
-/// with it, when the candidate's construction computed it already (has_vertex[t]).
+/// with it, when the candidate's construction computed it already (has_vertex(t)).
 struct DualSurface {
   std::vector<std::array<int, 3>> corner;
   std::vector<std::array<int, 3>> across;
-  HVertices vertex;  // empty, or one per triangle
-  std::vector<char> has_vertex;
+  // Empty (no vertices kept), or per triangle the index of its vertex in `vertices`, -1
+  // where it has none yet.
+  std::vector<int> slot;
+  VertexStore vertices;
   // Empty, or per plane: a triangle near the plane's dual point, for one that is not on the
   // surface (removed by a repair), where the check's climb starts; -1 where none is known.
   std::vector<int> near;
@@ -350,9 +456,17 @@ struct DualSurface {
 
   /// The far plane of triangle t's edge k: the corner of the triangle across it that is not
   /// on the edge (-1: none, a degenerate neighbour).
-  /// Triangle t's stored vertex (`vertex` not empty), made now when it has none (needs a
-  /// RoundingGuard).
+  bool keeps_vertices() const { return !slot.empty(); }
+  bool has_vertex(int t) const { return slot[t] >= 0; }
+  HVertex& vertex(int t) { return vertices[slot[t]]; }
+  /// Triangle t's stored vertex (keeps_vertices), made now when it has none (needs a
+  /// RoundingGuard). Made on several threads at once only after vertices.reserve.
   HVertex& stored_vertex(int t, const Planes& planes, const KnownPoints& known);
+  /// Triangle t's vertex dropped (one thread): its index is given out again.
+  void drop_vertex(int t) {
+    if (slot[t] >= 0) vertices.release(slot[t]);
+    slot[t] = -1;
+  }
 
   int far_corner(int t, int k) const {
     const int a = corner[t][k], b = corner[t][k == 2 ? 0 : k + 1];
@@ -536,11 +650,8 @@ HVertex independent_vertex_of(const Planes& planes, const std::array<int, 3>& ab
 }
 
 HVertex& DualSurface::stored_vertex(int t, const Planes& planes, const KnownPoints& known) {
-  if (!has_vertex[t]) {
-    vertex[t] = independent_vertex_of(planes, corner[t], known);
-    has_vertex[t] = 1;
-  }
-  return vertex[t];
+  if (slot[t] < 0) slot[t] = vertices.add(independent_vertex_of(planes, corner[t], known));
+  return vertices[slot[t]];
 }
 
 /// Whether plane i is known to pass through vertex v (no arithmetic).
@@ -1104,11 +1215,21 @@ int compare_exact(const Plane& p, const HVertex& u, const HVertex& v) {
   return CGAL::sign(dot(p.n(), *u.X) * *v.W - dot(p.n(), *v.X) * *u.W);
 }
 
+/// The intersection's vertices: vertex g is store[index[g]], where a candidate's tests made
+/// it or where it was added after them.
+struct IndexedVertices {
+  VertexStore store;
+  std::vector<int> index;
+  HVertex& operator[](int g) { return store[index[g]]; }
+  const HVertex& operator[](int g) const { return store[index[g]]; }
+  int size() const { return static_cast<int>(index.size()); }
+};
+
 /// Exact vertex coordinates made on first use, by whichever thread needs them first (each
 /// at most once; they do not depend on the thread, so neither does any decision).
 class LazyExact {
  public:
-  LazyExact(const Planes& planes, HVertices& vertex)
+  LazyExact(const Planes& planes, IndexedVertices& vertex)
       : planes_(planes), vertex_(vertex), once_(vertex.size()) {}
   const HVertex& operator()(int v) {
     once_.call(v, [&] { make_exact(planes_, vertex_[v]); });
@@ -1117,7 +1238,7 @@ class LazyExact {
 
  private:
   const Planes& planes_;
-  HVertices& vertex_;
+  IndexedVertices& vertex_;
   OnceFlags once_;
 };
 
@@ -1391,7 +1512,7 @@ namespace {
 
 /// Whether the facet cycle `cyc` runs clockwise about `normal` (interval Newell normal of
 /// the vertices, rationals when that cannot decide).
-bool clockwise(const std::vector<int>& cyc, const HVertices& vertex, const V3<ExactN>& normal,
+bool clockwise(const std::vector<int>& cyc, const IndexedVertices& vertex, const V3<ExactN>& normal,
                LazyExact& exact_vertex) {
   const int n = static_cast<int>(cyc.size());
   {
@@ -1423,7 +1544,7 @@ class VertexExactPoints final : public LazyExactPoints {
   /// that `planes` and the vertices point at, unless `owner` keeps them (intersect_halfspaces):
   /// without it, the planes of the vertices still without exact coordinates are copied with
   /// their exact values (the others are never read), and so are the known points.
-  VertexExactPoints(const Planes& planes, HVertices vertex, std::vector<int> order,
+  VertexExactPoints(const Planes& planes, IndexedVertices vertex, std::vector<int> order,
                     std::shared_ptr<const void> owner)
       : planes_(owner ? planes : Planes(planes.size())),
         vertex_(std::move(vertex)),
@@ -1431,13 +1552,14 @@ class VertexExactPoints final : public LazyExactPoints {
         once_(order_.size()),
         owner_(std::move(owner)) {
     if (owner_) return;
-    parallel_chunks(static_cast<int>(vertex_.size()), 256, [&](int begin, int end) {
+    parallel_chunks(vertex_.size(), 256, [&](int begin, int end) {
       for (int i = begin; i < end; ++i) {
         HVertex& v = vertex_[i];
         if (v.X && !v.made) set_exact(v, *v.X, *v.W);
       }
     });
-    for (const HVertex& v : vertex_) {
+    for (int i = 0; i < vertex_.size(); ++i) {
+      const HVertex& v = vertex_[i];
       if (v.X || v.exact_dd) continue;  // (exact_dd: made from its own copy)
       for (int i : v.planes) {
         if (planes_[i].n_exact) continue;
@@ -1458,7 +1580,7 @@ class VertexExactPoints final : public LazyExactPoints {
 
  private:
   Planes planes_;
-  mutable HVertices vertex_;  // each written once, under its flag in once_
+  mutable IndexedVertices vertex_;  // each written once, under its flag in once_
   std::vector<int> order_;
   OnceFlags once_;
   std::shared_ptr<const void> owner_;  // of what planes_ and vertex_ point at, or null
@@ -1482,8 +1604,9 @@ std::optional<V3<Interval>> precise_enclosure(const HVertex& v) {
 /// (`vertex` is moved away): computed on demand (VertexExactPoints), with the precise
 /// coordinates, or, when `eager`, all computed now and without precise coordinates (the
 /// route before, which tests compare with).
-ExactPoints polytope_points(const Planes& planes, HVertices& vertex, const std::vector<int>& order,
-                            bool eager, std::shared_ptr<const void> owner) {
+ExactPoints polytope_points(const Planes& planes, IndexedVertices& vertex,
+                            const std::vector<int>& order, bool eager,
+                            std::shared_ptr<const void> owner) {
   const int nv = static_cast<int>(order.size());
   ExactPoints exact;
   if (eager) {
@@ -1811,7 +1934,11 @@ class SurfaceRepair {
       if (s_.corner[t][k] == a) return k;
     return -1;
   }
-  HVertex& vertex_at(int t) { return s_.stored_vertex(t, planes_, known_); }
+  HVertex& vertex_at(int t) {
+    if (s_.slot[t] < 0)
+      s_.slot[t] = s_.vertices.add_reusing(independent_vertex_of(planes_, s_.corner[t], known_));
+    return s_.vertex(t);
+  }
   /// Sign of det(n_a, n_b, n_c): the dual points' filter, then det_sign.
   int orientation(int a, int b, int c) const {
     if (dual_) {
@@ -1863,7 +1990,7 @@ class SurfaceRepair {
   /// compute, its tests forgotten.
   void make_triangle(int t, const std::array<int, 3>& corners) {
     s_.corner[t] = corners;
-    s_.has_vertex[t] = 0;
+    s_.drop_vertex(t);
     dead_[t] = 0;
     changed_[t] = 1;
     forget(t);
@@ -1871,6 +1998,7 @@ class SurfaceRepair {
   /// Triangle t removed: its slot free for a new one.
   void kill(int t) {
     dead_[t] = 1;
+    s_.drop_vertex(t);
     free_.push_back(t);
   }
   /// A slot for one more triangle (an insertion's cone has two more than it replaces): a
@@ -1885,8 +2013,7 @@ class SurfaceRepair {
     }
     s_.corner.emplace_back();
     s_.across.emplace_back();
-    s_.vertex.emplace_back();
-    s_.has_vertex.push_back(0);
+    s_.slot.push_back(-1);
     dead_.push_back(0);
     changed_.push_back(1);
     mark_.push_back(0);
@@ -2062,10 +2189,7 @@ bool SurfaceRepair::lift(int t, int i) {
   const int made = k - 2;
   for (int r = 0; r < made; ++r) {
     make_triangle(fan_[r], ears_[r]);
-    if (ear_vertex_[r]) {
-      s_.vertex[fan_[r]] = std::move(*ear_vertex_[r]);
-      s_.has_vertex[fan_[r]] = 1;
-    }
+    if (ear_vertex_[r]) s_.slot[fan_[r]] = s_.vertices.add_reusing(std::move(*ear_vertex_[r]));
   }
   for (int r = 0; r < made; ++r) {
     for (int e = 0; e < 3; ++e) {
@@ -2390,13 +2514,11 @@ bool SurfaceRepair::compact() {
     const int r = index[t];
     s_.corner[r] = s_.corner[t];
     s_.across[r] = {index[s_.across[t][0]], index[s_.across[t][1]], index[s_.across[t][2]]};
-    if (r != t && s_.has_vertex[t]) s_.vertex[r] = std::move(s_.vertex[t]);  // (changed: none)
-    s_.has_vertex[r] = s_.has_vertex[t];
+    s_.slot[r] = s_.slot[t];
   }
   s_.corner.resize(kept);
   s_.across.resize(kept);
-  s_.vertex.resize(kept);
-  s_.has_vertex.resize(kept);
+  s_.slot.resize(kept);
   for (const auto& a : s_.across)
     for (int x : a)
       if (x < 0) return false;
@@ -2461,8 +2583,8 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
   // A vertex the candidate computed from its corners' planes, in order (not a known point),
   // has W = det(n_a, n_b, n_c) in intervals: positive there is the test passed.
   const auto oriented = [&](int t) {
-    if (!s.has_vertex.empty() && s.has_vertex[t]) {
-      const HVertex& v = s.vertex[t];
+    if (s.keeps_vertices() && s.has_vertex(t)) {
+      const HVertex& v = s.vertex(t);
       if (v.known < 0 && v.planes == s.corner[t] && w_positive(v)) return true;
     }
     return det_sign(s.dual.get(), planes, precise, s.corner[t][0], s.corner[t][1], s.corner[t][2]) >
@@ -2576,9 +2698,10 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
   // last coordinate; the rows' order differs by two swaps), so the triangle with the
   // larger index takes its neighbour's sign. Signs the candidate knows (s.far_side: the
   // flips' tests of a polygon's diagonals, the repair's unchanged edges) are not tested.
-  const bool stored = !s.vertex.empty();
+  const bool stored = s.keeps_vertices();
   const bool can_repair = repaired && stored;
-  std::atomic<bool> reflex = false;  // an edge to repair
+  if (stored) s.vertices.reserve(nt);  // (at most one vertex a triangle, made in parallel)
+  std::atomic<bool> reflex = false;    // an edge to repair
   std::vector<signed char> far_side(3 * static_cast<std::size_t>(nt));
   // The slot of triangle t's edge k in the triangle across it, where that one runs back
   // along it and has t across; -1 otherwise (then each side is tested on its own).
@@ -2705,33 +2828,28 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
     }
   }
   const int nv = static_cast<int>(seed.size());
-  // Each group's vertex is its seed's, moved in place to index g (seed[g] >= g, and seeds
-  // increase: a source is never an earlier destination); none moves when every group is a
-  // single triangle.
-  HVertices vertex;
+  // Each group's vertex is its seed's where the candidate made that one (kept where it is);
+  // the others are made now, each chunk's in a row.
+  IndexedVertices vertex;
+  vertex.index.assign(nv, -1);
   if (stored) {
-    if (!simple)
-      for (int g = 0; g < nv; ++g)
-        if (seed[g] != g) {
-          s.has_vertex[g] = s.has_vertex[seed[g]];
-          if (s.has_vertex[g]) s.vertex[g] = std::move(s.vertex[seed[g]]);
-        }
-    s.vertex.resize(nv);
-    vertex = std::move(s.vertex);
-    // The seeds whose tests did not need their vertex.
-    parallel_chunks(nv, 256, [&](int begin, int end) {
-      RoundingGuard guard;
-      for (int g = begin; g < end; ++g)
-        if (!s.has_vertex[g]) vertex[g] = independent_vertex_of(planes, s.corner[seed[g]], known);
-    });
-  } else {
-    vertex.resize(nv);
-    parallel_chunks(nv, 256, [&](int begin, int end) {
-      RoundingGuard guard;
-      for (int g = begin; g < end; ++g)
-        vertex[g] = independent_vertex_of(planes, s.corner[seed[g]], known);
-    });
+    vertex.store = std::move(s.vertices);
+    vertex.store.forget_released();
+    for (int g = 0; g < nv; ++g) vertex.index[g] = s.slot[seed[g]];
   }
+  vertex.store.reserve(nv);
+  parallel_chunks(nv, 256, [&](int begin, int end) {
+    RoundingGuard guard;
+    int missing = 0;
+    for (int g = begin; g < end; ++g) missing += vertex.index[g] < 0;
+    if (missing == 0) return;
+    int next = vertex.store.add_range(missing);
+    for (int g = begin; g < end; ++g)
+      if (vertex.index[g] < 0) {
+        vertex.index[g] = next++;
+        vertex[g] = independent_vertex_of(planes, s.corner[seed[g]], known);
+      }
+  });
   // The vertex graph (edges between groups): each vertex's neighbours in increasing order,
   // once. A simple surface's are the three triangles across, sorted in place when distinct
   // (and not the triangle itself); otherwise a counting pass by vertex, then each short list
@@ -2808,8 +2926,10 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
   // others when the walk below first needs them.
   {
     std::vector<char> used(n, 0);
-    for (const HVertex& v : vertex)
+    for (int g = 0; g < vertex.size(); ++g) {
+      const HVertex& v = vertex[g];
       if (v.known < 0 && !v.precise) used[v.planes[0]] = used[v.planes[1]] = used[v.planes[2]] = 1;
+    }
     parallel_chunks(n, 256, [&](int begin, int end) {
       for (int i = begin; i < end; ++i)
         if (used[i]) precise[i];
@@ -2952,12 +3072,11 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
       if (cut[j] >= 0) cutting.emplace_back(others[j], triangle_of[cut[j]]);
     // The triangles' vertices, where each is its own group; otherwise made again.
     if (identity) {
-      s.vertex = std::move(vertex);
-      s.has_vertex.assign(nt, 1);
+      s.vertices = std::move(vertex.store);
+      s.slot = std::move(vertex.index);
     } else {
-      s.vertex.clear();
-      s.vertex.resize(nt);
-      s.has_vertex.assign(nt, 0);
+      s.vertices = VertexStore();
+      s.slot.assign(nt, -1);
     }
     s.far_side = std::move(far_side);
     if (!SurfaceRepair(planes, precise, known, s, counts).insert_cutting(cutting))
@@ -3209,12 +3328,12 @@ class IncrementalHull {
     // Each triangle's vertex for the check, as far as the run computed it (the intervals of
     // its meet, its precise and exact coordinates, its known point); one whose W is not
     // positive by intervals is left to the check.
-    out.vertex.resize(out.corner.size());
-    out.has_vertex.assign(out.corner.size(), 0);
+    out.slot.assign(out.corner.size(), -1);
     for (std::size_t t = 0; t < tris_.size(); ++t) {
       const Tri& tri = tris_[t];
       if (!tri.alive || !(tri.Wi.inf() > 0)) continue;
-      HVertex& v = out.vertex[index[t]];
+      out.slot[index[t]] = out.vertices.add_range(1);
+      HVertex& v = out.vertex(index[t]);
       v.planes = tri.c;
       if (tri.known >= 0) {
         set_known(known_, tri.known, v);
@@ -3233,7 +3352,6 @@ class IncrementalHull {
         v.precise_tried = tri.precise != -1;
         if (tri.exact >= 0) set_exact(v, exact_[tri.exact].X, exact_[tri.exact].W);
       }
-      out.has_vertex[index[t]] = 1;
     }
     return Outcome::hull;
   }
@@ -3673,8 +3791,8 @@ constexpr int kFlipsPerCorner = 4;
 /// (ExpectedVertices::split). After kFlipsPerCorner k flips it stops with the triangulation
 /// as it is: the diagonals it has not tested, like a triangle never tested, are left to the
 /// check (and its repair).
-/// When it splits the polygon, each final triangle's vertex is in out_vertex (out_has set;
-/// it is the flips' scratch space on the way).
+/// When it splits the polygon, each final triangle's vertex is added to `store` (which has
+/// room reserved for it: this runs on several threads) and its index written to out_slot.
 /// out_far (3 per triangle) gets the check's far-plane sign of each diagonal's edge (see
 /// build_verified; 2 for the polygon's own edges): the last test of each diagonal, made
 /// with its final triangles, or for a diagonal a flip made, -1 (the flipped test's four
@@ -3683,7 +3801,7 @@ constexpr int kFlipsPerCorner = 4;
 /// Needs a RoundingGuard.
 bool triangulate_polygon(const Planes& planes, const PrecisePlanes& precise,
                          const KnownPoints& known, const V3<double>& o, const int* p, int k,
-                         bool split, std::array<int, 3>* out, HVertex* out_vertex, char* out_has,
+                         bool split, std::array<int, 3>* out, VertexStore* store, int* out_slot,
                          signed char* out_far, PolygonScratch& scratch) {
   // Planes through one known point (facets of A moved by one vertex of B): one vertex.
   if (k == 3 || common_point(known, p, k) >= 0) {
@@ -3699,7 +3817,13 @@ bool triangulate_polygon(const Planes& planes, const PrecisePlanes& precise,
   }
   if (!split) return false;
   auto& triangle = scratch.triangle;
-  HVertex* vertex = out_vertex;  // each triangle's vertex, computed where it is ready
+  // Each triangle's vertex, computed where it is ready, in the store from the start.
+  struct InStore {
+    VertexStore& store;
+    int first;
+    HVertex& operator[](int t) const { return store[first + t]; }
+  };
+  const InStore vertex{*store, store->add_range(k - 2)};
   auto& ready = scratch.ready;
   auto& pending = scratch.pending;
   triangle.clear();
@@ -3891,8 +4015,9 @@ bool triangulate_polygon(const Planes& planes, const PrecisePlanes& precise,
       out_far[3 * t + m] = diagonal_side(x, y);  // (2 for the polygon's sides: never set)
     }
     if (!ready[t]) compute_vertex(static_cast<int>(t));
-    out_has[t] = 1;
   }
+  for (std::size_t t = 0; t < triangle.size(); ++t)
+    out_slot[t] = vertex.first + static_cast<int>(t);
   return true;
 }
 
@@ -3972,16 +4097,16 @@ DualSurface expected_surface(const Planes& planes, const PrecisePlanes& precise,
   const int nt = first[nv];
   s.corner.resize(nt);
   if (expected.split) {  // otherwise no polygon splits, and none has vertices to keep
-    s.vertex.resize(nt);
-    s.has_vertex.assign(nt, 0);
+    s.slot.assign(nt, -1);
+    s.vertices.reserve(nt);  // (room for all: made on several threads)
   }
   s.far_side.resize(3 * static_cast<std::size_t>(nt));
   std::atomic<bool> ok = true;
   const auto triangulate = [&](int v, PolygonScratch& scratch) {
     if (!triangulate_polygon(planes, precise, known, o, &expected.facets[expected.begin[v]],
                              expected.begin[v + 1] - expected.begin[v], expected.split,
-                             &s.corner[first[v]], expected.split ? &s.vertex[first[v]] : nullptr,
-                             expected.split ? &s.has_vertex[first[v]] : nullptr,
+                             &s.corner[first[v]], &s.vertices,
+                             expected.split ? &s.slot[first[v]] : nullptr,
                              &s.far_side[3 * static_cast<std::size_t>(first[v])], scratch))
       ok = false;
   };
