@@ -2045,6 +2045,13 @@ class SurfaceRepair {
   // stays on the surface, start the climb: near the lifted dual point however the surface
   // changed since).
   std::vector<std::pair<int, int>> off_;
+  // Per plane taken off (removed or lifted): a neighbour it had then, on the surface at the
+  // time, else -1. Where that one went too, its own leads on: a start near the plane's dual
+  // point among those still on the surface. (Most lifted planes' own neighbours go later:
+  // icosphere level 7 by icosphere(0.25, 1), 11,555 of 12,044 insertions started where the
+  // last one ended, 21 steps each; 242,120 insertion steps to 70,173, on a UV sphere of
+  // 512 x 512 by a quarter-size snub dodecahedron 336,156 to 77,283.)
+  std::vector<int> via_;
   int budget_ = 0;
   int last_ = -1;  // where the last insertion's walk ended (a start when x's own is gone)
   // Scratch of lift and insert.
@@ -2056,6 +2063,7 @@ class SurfaceRepair {
   std::vector<unsigned> mark_;  // per triangle: 2 stamp_ (cut off), 2 stamp_ + 1 (not)
   unsigned stamp_ = 0;
   static constexpr int kMaxDegree = 1 << 12;
+  static constexpr int kMaxHops = 64;  // along via_
 };
 
 // Removes corner slot i of triangle t when it has three neighbours: t = (x, y, z),
@@ -2073,6 +2081,7 @@ bool SurfaceRepair::remove(int t, int i) {
   if (!positive(y, z, d)) return false;
   if (!relink(Z, d, z, t) || !relink(Y, y, d, t)) return false;
   s_.near[x] = t;  // x's dual point lies beneath t
+  via_[x] = y;
   // (Strictly: the reflex edge's test is x's, and the fan of three positive triangles about
   // x covers the cone of y, z, d once, x's dual point in it.)
   s_.inside[x] = 1;
@@ -2215,6 +2224,7 @@ bool SurfaceRepair::lift(int t, int i) {
   // its neighbours' polygon, which winds around it) beneath that ear: inside the dual hull
   // of all the planes, so its plane bounds nothing (or touches), and it stays off.
   if (!beneath) off_.emplace_back(x, link_[0]);
+  via_[x] = link_[0];
   for (int r = 0; r < made; ++r) push_edges(fan_[r]);
   return true;
 }
@@ -2372,6 +2382,7 @@ bool SurfaceRepair::run(const std::vector<std::pair<int, int>>& reflex) {
   const int nt = size();
   s_.near.assign(planes_.size(), -1);
   s_.inside.assign(planes_.size(), 0);
+  via_.assign(planes_.size(), -1);
   for (auto it = reflex.rbegin(); it != reflex.rend(); ++it)
     queue_.push_back(
         {it->first, s_.corner[it->first][it->second], s_.corner[it->first][next(it->second)]});
@@ -2450,8 +2461,9 @@ bool SurfaceRepair::run(const std::vector<std::pair<int, int>>& reflex) {
       if (!dead_[t])
         for (const int p : s_.corner[t]) triangle_at[p] = t;
     for (const auto& [x, neighbour] : off_) {
-      if (triangle_at[neighbour] >= 0 && !dead_[triangle_at[neighbour]])
-        s_.near[x] = triangle_at[neighbour];
+      int p = neighbour;
+      for (int hop = 0; triangle_at[p] < 0 && via_[p] >= 0 && hop < kMaxHops; ++hop) p = via_[p];
+      if (triangle_at[p] >= 0 && !dead_[triangle_at[p]]) s_.near[x] = triangle_at[p];
       if (!insert(x)) return false;
     }
   }
