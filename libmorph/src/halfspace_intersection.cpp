@@ -1727,11 +1727,13 @@ class HalfSpaceNormals final : public GivenNormals::Source {
     const int shift = -std::ilogb(largest);
     if (std::abs(shift) > 900) return false;  // (precise_given's range)
     out = {};
+    // (Times 2^shift, a normal double: rounded as ldexp rounds, in one multiplication.)
+    const double scale = std::ldexp(1.0, shift);
     for (int i = 0; i < 3; ++i) {
       const DD& c = h.normal_dd[i];
       if (c.hi == 0) continue;  // exactly zero (within 2^-101 of 0): hi = lo = error = 0
-      out.hi[i] = std::ldexp(c.hi, shift);
-      out.lo[i] = std::ldexp(c.lo, shift);
+      out.hi[i] = c.hi * scale;
+      out.lo[i] = c.lo * scale;
       // The bound scales exactly; so does lo, unless it comes out subnormal.
       out.error[i] = 0x1p-101 * std::abs(out.hi[i]);
       if (c.lo != 0 && std::abs(out.lo[i]) < std::numeric_limits<double>::min())

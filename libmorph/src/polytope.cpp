@@ -288,9 +288,18 @@ void Polytope::compute_normals(bool units_known) {
     // enclosures give loose ones (an erosion's vertices of nearly parallel planes: at
     // icosphere level 6 by its rotated copy, about 2e-5 against 1e-14 from the meets'
     // intervals), which left the next sum's double filters undecided nearly everywhere.
+    // (A copy the source has at hand goes straight into the cache, which no one reads yet.)
     parallel_chunks(nf, 1024, [&](int begin, int end) {
       RoundingGuard nearest(CGAL_FE_TONEAREST);  // (the precise copies' splits)
-      for (int f = begin; f < end; ++f) unit_normals[f] = unit_of_precise(precise_normal(f));
+      PreciseNormal copy;
+      for (int f = begin; f < end; ++f) {
+        if (given_normals.precise(f, copy)) {
+          precise_cache_->set(f, copy);
+          unit_normals[f] = unit_of_precise(copy);
+        } else {
+          unit_normals[f] = unit_of_precise(precise_normal(f));
+        }
+      }
     });
   } else if (exact_points.empty()) {
     parallel_chunks(nf, 1024, [&](int begin, int end) {

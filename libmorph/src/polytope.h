@@ -293,6 +293,11 @@ struct Polytope {
         run_once(s, [&] { value[f] = compute(); });
       return value[f];
     }
+    /// Slot f's value, set before any reader comes (the polytope being built).
+    void set(int f, const T& v) {
+      value[f] = v;
+      state[f].store(once_state::kDone, std::memory_order_release);
+    }
     std::unique_ptr<T[]> value;
     std::unique_ptr<std::atomic<unsigned char>[]> state;  // value-initialised: kNone
   };
