@@ -460,8 +460,10 @@ struct DualSurface {
   bool has_vertex(int t) const { return slot[t] >= 0; }
   HVertex& vertex(int t) { return vertices[slot[t]]; }
   /// Triangle t's stored vertex (keeps_vertices), made now when it has none (needs a
-  /// RoundingGuard). Made on several threads at once only after vertices.reserve.
-  HVertex& stored_vertex(int t, const Planes& planes, const KnownPoints& known);
+  /// RoundingGuard). Made on several threads at once only after vertices.reserve, and
+  /// then not `reusing` an index dropped before (one thread: a repair).
+  HVertex& stored_vertex(int t, const Planes& planes, const KnownPoints& known,
+                         bool reusing = false);
   /// Triangle t's vertex dropped (one thread): its index is given out again.
   void drop_vertex(int t) {
     if (slot[t] >= 0) vertices.release(slot[t]);
@@ -649,8 +651,12 @@ HVertex independent_vertex_of(const Planes& planes, const std::array<int, 3>& ab
   return v;
 }
 
-HVertex& DualSurface::stored_vertex(int t, const Planes& planes, const KnownPoints& known) {
-  if (slot[t] < 0) slot[t] = vertices.add(independent_vertex_of(planes, corner[t], known));
+HVertex& DualSurface::stored_vertex(int t, const Planes& planes, const KnownPoints& known,
+                                    bool reusing) {
+  if (slot[t] < 0) {
+    HVertex v = independent_vertex_of(planes, corner[t], known);
+    slot[t] = reusing ? vertices.add_reusing(std::move(v)) : vertices.add(std::move(v));
+  }
   return vertices[slot[t]];
 }
 
@@ -1947,11 +1953,7 @@ class SurfaceRepair {
       if (s_.corner[t][k] == a) return k;
     return -1;
   }
-  HVertex& vertex_at(int t) {
-    if (s_.slot[t] < 0)
-      s_.slot[t] = s_.vertices.add_reusing(independent_vertex_of(planes_, s_.corner[t], known_));
-    return s_.vertex(t);
-  }
+  HVertex& vertex_at(int t) { return s_.stored_vertex(t, planes_, known_, /*reusing=*/true); }
   /// Sign of det(n_a, n_b, n_c): the dual points' filter, then det_sign.
   int orientation(int a, int b, int c) const {
     if (dual_) {
