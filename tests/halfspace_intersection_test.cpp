@@ -23,6 +23,7 @@
 
 #include "fims.h"
 #include "huge_pages.h"
+#include "parallel.h"
 #include "support/polytopes.h"
 
 namespace {
@@ -150,8 +151,10 @@ bool unit_normal_holds(const Polytope& p, int f) {
 /// First difference between two polytopes in any field (positions, exact points, normals,
 /// connectivity, labels), or "". Unit normals are enclosures: two that differ must each hold
 /// (unit_normal_holds); an eroded polytope takes its own from its half-spaces' double-double
-/// normals, a copy of it from the vertices.
-std::string polytope_difference(const Polytope& a, const Polytope& b) {
+/// normals, a copy of it from the vertices. `projective`: exact points (X, W) that are the
+/// same point, X / W, count as the same (a vertex of four planes or more may come from
+/// another three of them, with another scale).
+std::string polytope_difference(const Polytope& a, const Polytope& b, bool projective = false) {
   if (a.num_vertices() != b.num_vertices()) return "vertex counts differ";
   for (int v = 0; v < a.num_vertices(); ++v) {
     const V3<double>&p = a.points[v], &q = b.points[v];
@@ -159,8 +162,10 @@ std::string polytope_difference(const Polytope& a, const Polytope& b) {
     if (a.exact_points.empty() != b.exact_points.empty()) return "exactness differs";
     if (a.exact_points.empty()) continue;
     const V3<ExactN>&x = a.exact_points.X(v), &y = b.exact_points.X(v);
-    if (x.x != y.x || x.y != y.y || x.z != y.z || a.exact_points.W(v) != b.exact_points.W(v))
-      return "exact point " + std::to_string(v) + " differs";
+    const ExactN &w = a.exact_points.W(v), &z = b.exact_points.W(v);
+    const bool same = projective ? x.x * z == y.x * w && x.y * z == y.y * w && x.z * z == y.z * w
+                                 : x.x == y.x && x.y == y.y && x.z == y.z && w == z;
+    if (!same) return "exact point " + std::to_string(v) + " differs";
   }
   if (a.given_normals.size() != b.given_normals.size()) return "given normal counts differ";
   for (std::size_t f = 0; f < a.given_normals.size(); ++f) {
@@ -196,6 +201,21 @@ void check_direct_polytope(const Polytope& A, const Polytope& B, const MaybePoly
   const MaybePolytope general = erode_polytope(A, B, {.direct_polytope = false});
   REQUIRE(direct.reason == general.reason);
   if (direct.polytope) CHECK(polytope_difference(*direct.polytope, *general.polytope) == "");
+}
+
+/// Two repairs and checks acted alike: the same counts of each action (not of the tests that
+/// decided them).
+void check_same_actions(const RepairCounts& a, const RepairCounts& b) {
+  CHECK(a.flips == b.flips);
+  CHECK(a.removals == b.removals);
+  CHECK(a.lifts == b.lifts);
+  CHECK(a.insertions == b.insertions);
+  CHECK(a.cuts == b.cuts);
+  CHECK(a.insert_steps == b.insert_steps);
+  CHECK(a.check_planes == b.check_planes);
+  CHECK(a.check_steps == b.check_steps);
+  CHECK(a.regions == b.regions);
+  CHECK(a.handed_over == b.handed_over);
 }
 
 /// A (-) B by erode_polytope's guess (A's vertices), by the incremental hull alone and by
@@ -1182,6 +1202,56 @@ TEST_CASE("halfspace_intersection: planes put back walk a few triangles to their
   CHECK(counts.check_steps < 16 * counts.check_planes);
 }
 
+// A large guess's repair runs first in six regions, in parallel (each worker acts where all
+// it touches is its own, and leaves the edges across the borders, or stuck there, to one
+// pass over the whole surface): the same polytope, field by field, as one pass over the
+// whole surface, on one thread or two, with the same actions whatever the threads. Here
+// the regions are forced on small surfaces (repair_regions_from 1); a UV sphere's poles
+// gather the lifts into two of them.
+TEST_CASE("halfspace_intersection: a repair in regions gives the whole surface's result") {
+  struct Case {
+    morph::Mesh A, B;
+  };
+  const Case cases[] = {
+      {morph::make_uv_sphere(1.0, 120), morph::test::cube(0.3)},
+      {morph::make_uv_sphere(1.0, 66), morph::test::scaled(sample("snub_dodecahedron.off"), 0.25)},
+      {morph::make_icosphere(1.0, 4), morph::make_icosphere(0.25, 1)},
+  };
+  for (const Case& c : cases) {
+    const Polytope A = make_operand(c.A, "A");
+    const Polytope B = make_operand(c.B, "B");
+    CAPTURE(A.num_faces());
+    RepairCounts whole;
+    const MaybePolytope expected =
+        erode_polytope(A, B, {.counts = &whole, .repair_regions_from = 0});
+    REQUIRE(expected.polytope);
+    CHECK(expected.route == HullRoute::repaired);
+    CHECK(whole.regions == 0);
+    CHECK(difference(expected, erode_polytope(A, B, {.incremental = false})) == "");
+    RepairCounts first;
+    for (const int threads : {1, 2}) {
+      CAPTURE(threads);
+      RepairCounts counts;
+      const MaybePolytope r = morph::detail::run_with_threads(threads, [&] {
+        return erode_polytope(A, B, {.counts = &counts, .repair_regions_from = 1});
+      });
+      REQUIRE(r.polytope);
+      CHECK(r.route == HullRoute::repaired);
+      CHECK(difference(r, expected) == "");
+      CHECK(polytope_difference(*r.polytope, *expected.polytope, /*projective=*/true) == "");
+      CHECK(counts.regions == 6);
+      CHECK(counts.handed_over > 0);
+      CHECK(counts.flips > 0);
+      if (threads == 1) {
+        first = counts;
+        continue;
+      }
+      check_same_actions(counts, first);
+      CHECK(counts.dual_decided == first.dual_decided);
+    }
+  }
+}
+
 // The allocator of the largest arrays (huge_pages.h): blocks from operator new below
 // kHugeBlock, mapped with huge-page advice above it; a vector growing across the threshold
 // keeps its values, and copies, moves and shrinks free what they should (the sanitizer
@@ -1233,14 +1303,7 @@ TEST_CASE("halfspace_intersection: the dual points' filter decides as the planes
     CHECK(r.route == HullRoute::repaired);
     CHECK(difference(erode_polytope(A, B, {.counts = &without, .dual_filter = false}), r) == "");
     CHECK(with.flips > 0);
-    CHECK(with.flips == without.flips);
-    CHECK(with.removals == without.removals);
-    CHECK(with.lifts == without.lifts);
-    CHECK(with.insertions == without.insertions);
-    CHECK(with.cuts == without.cuts);
-    CHECK(with.insert_steps == without.insert_steps);
-    CHECK(with.check_planes == without.check_planes);
-    CHECK(with.check_steps == without.check_steps);
+    check_same_actions(with, without);
     CHECK(without.dual_decided + without.dual_undecided == 0);
     CAPTURE(with.dual_decided);
     CAPTURE(with.dual_undecided);

@@ -229,6 +229,28 @@ struct RepairCounts {
   // then made found otherwise (none, or the argument is wrong).
   long certified = 0;
   long certified_wrong = 0;
+  // Repairs run first in regions (IntersectOptions::repair_regions_from): the regions, and
+  // the edges they left to the whole surface's pass (across their borders, or stuck there).
+  long regions = 0;
+  long handed_over = 0;
+
+  RepairCounts& operator+=(const RepairCounts& o) {
+    flips += o.flips;
+    removals += o.removals;
+    lifts += o.lifts;
+    insertions += o.insertions;
+    cuts += o.cuts;
+    insert_steps += o.insert_steps;
+    check_planes += o.check_planes;
+    check_steps += o.check_steps;
+    dual_decided += o.dual_decided;
+    dual_undecided += o.dual_undecided;
+    certified += o.certified;
+    certified_wrong += o.certified_wrong;
+    regions += o.regions;
+    handed_over += o.handed_over;
+    return *this;
+  }
 };
 
 /// Options of intersect_halfspaces.
@@ -253,6 +275,11 @@ struct IntersectOptions {
   // repair's 3-1 flips took off (always certain, not walked to: DualSurface::inside).
   bool certify = true;
   bool verify_certified = false;
+  // A guess's repair runs first in six regions, in parallel, when it has at least this many
+  // triangles (0: never; tests make it small to cover the regions on small inputs). The
+  // result is the same polytope either way (its vertices and facets may come in another
+  // order), whatever the number of threads.
+  int repair_regions_from = 16384;
 };
 
 /// The exact value hi + lo of each coordinate.
