@@ -2133,6 +2133,8 @@ class SurfaceRepair {
   std::vector<char> clipped_, link_joined_;
   std::vector<std::array<int, 3>> ears_;
   std::vector<std::optional<HVertex>> ear_vertex_;  // computed where a test needed it
+  std::vector<signed char> ear_state_;              // per neighbour: what lift knows of its ear
+  std::vector<std::optional<HVertex>> ear_cache_;   // its vertex, where its test made it
   std::vector<std::pair<int, int>> horizon_;
   unsigned stamp_ = 0;
   static constexpr int kMaxDegree = 1 << 12;
@@ -2221,55 +2223,65 @@ bool SurfaceRepair::lift(int t, int i) {
     while (clipped_[a]);
     return a;
   };
+  // What is known of each neighbour b's ear (a, b, c), with a and c its neighbours left now
+  // (each test depends on those three, and on which neighbours are left only through the
+  // emptiness test; the choices are those of testing every ear each round, which made
+  // a lift's ear tests cubic in its neighbours).
+  enum : signed char { kUntested, kNoEar, kNotEmpty, kKeeps, kCuts };
+  ear_state_.assign(k, kUntested);
+  ear_cache_.clear();
+  ear_cache_.resize(k);
+  const auto test_ear = [&](int b, int left) {
+    const int a = prev_left(b), c = next_left(b);
+    if (left > 3 && link_joined_[a * k + c]) return kNoEar;
+    const int za = link_[a], zb = link_[b], zc = link_[c];
+    if (!positive(za, zb, zc)) return kNoEar;
+    for (int j = next_left(c); j != a; j = next_left(j)) {
+      const int z = link_[j];
+      if (orientation(za, zb, z) >= 0 && orientation(zb, zc, z) >= 0 && orientation(zc, za, z) >= 0)
+        return kNotEmpty;
+    }
+    // (The ear's vertex only where the dual points cannot tell x's side: the check
+    // computes it otherwise, once, if the ear lasts.)
+    int sx = 2;
+    if (dual_) {
+      sx = dual_side(dual_, {za, zb, zc}, x);
+      decided(sx);
+    }
+    if (sx == 2) {
+      ear_cache_[b] = independent_vertex_of(planes_, {za, zb, zc}, known_);
+      sx =
+          known_through(known_, x, *ear_cache_[b]) ? 0 : side(planes_, precise_, x, *ear_cache_[b]);
+    }
+    return sx <= 0 ? kKeeps : kCuts;
+  };
   bool beneath = true;  // every ear keeps x's plane
   for (int left = k; left >= 3; --left) {
-    // The first valid ear that keeps x's plane, else the first valid ear.
+    // The first valid ear that keeps x's plane, else the first valid ear. (The last ear
+    // skips the diagonal test: all are tested again. A neighbour clipped may have been
+    // inside an ear: those are tested again each round.)
     int chosen = -1, fallback = -1;
-    std::optional<HVertex> chosen_vertex, fallback_vertex;
     for (int b = 0; b < k && chosen < 0; ++b) {
       if (clipped_[b]) continue;
-      const int a = prev_left(b), c = next_left(b);
-      if (left > 3 && link_joined_[a * k + c]) continue;
-      const int za = link_[a], zb = link_[b], zc = link_[c];
-      if (!positive(za, zb, zc)) continue;
-      bool empty = true;
-      for (int j = next_left(c); j != a && empty; j = next_left(j)) {
-        const int z = link_[j];
-        empty =
-            orientation(za, zb, z) < 0 || orientation(zb, zc, z) < 0 || orientation(zc, za, z) < 0;
-      }
-      if (!empty) continue;
-      // (The ear's vertex only where the dual points cannot tell x's side: the check
-      // computes it otherwise, once, if the ear lasts.)
-      std::optional<HVertex> v;
-      int sx = 2;
-      if (dual_) {
-        sx = dual_side(dual_, {za, zb, zc}, x);
-        decided(sx);
-      }
-      if (sx == 2) {
-        v = independent_vertex_of(planes_, {za, zb, zc}, known_);
-        sx = known_through(known_, x, *v) ? 0 : side(planes_, precise_, x, *v);
-      }
-      if (sx <= 0) {
-        chosen = b;
-        chosen_vertex = std::move(v);
-      } else if (fallback < 0) {
-        fallback = b;
-        fallback_vertex = std::move(v);
-      }
+      signed char& state = ear_state_[b];
+      if (state == kUntested || state == kNotEmpty || left == 3) state = test_ear(b, left);
+      if (state == kKeeps) chosen = b;
+      if (state == kCuts && fallback < 0) fallback = b;
     }
     if (chosen < 0) {
       if (fallback < 0) return false;
       chosen = fallback;
-      chosen_vertex = std::move(fallback_vertex);
       beneath = false;
     }
     const int a = prev_left(chosen), c = next_left(chosen);
     ears_.push_back({link_[a], link_[chosen], link_[c]});
-    ear_vertex_.push_back(std::move(chosen_vertex));
+    ear_vertex_.push_back(std::move(ear_cache_[chosen]));
     link_joined_[a * k + c] = link_joined_[c * k + a] = 1;
     clipped_[chosen] = 1;
+    for (const int n : {a, c}) {  // (their ears change)
+      ear_state_[n] = kUntested;
+      ear_cache_[n].reset();
+    }
   }
   // The ears in the first k - 2 fan slots: across a link edge z_m -> z_m+1 lies outer[m];
   // across a diagonal, the other ear along it.
