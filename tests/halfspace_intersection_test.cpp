@@ -1202,12 +1202,12 @@ TEST_CASE("halfspace_intersection: planes put back walk a few triangles to their
   CHECK(counts.check_steps < 16 * counts.check_planes);
 }
 
-// A large guess's repair runs first in six regions, in parallel (each worker acts where all
-// it touches is its own, and leaves the edges across the borders, or stuck there, to one
-// pass over the whole surface): the same polytope, field by field, as one pass over the
+// A large guess's repair on several threads runs first in six regions, in parallel (each
+// worker acts where all it touches is its own, and leaves the edges across the borders to
+// passes over the whole surface): the same polytope, field by field, as one pass over the
 // whole surface, on one thread or two, with the same actions whatever the threads. Here
-// the regions are forced on small surfaces (repair_regions_from 1); a UV sphere's poles
-// gather the lifts into two of them.
+// the regions are forced on small surfaces and on one thread (repair_regions_from 1,
+// repair_regions_on_one_thread); a UV sphere's poles gather the lifts into two of them.
 TEST_CASE("halfspace_intersection: a repair in regions gives the whole surface's result") {
   struct Case {
     morph::Mesh A, B;
@@ -1233,7 +1233,9 @@ TEST_CASE("halfspace_intersection: a repair in regions gives the whole surface's
       CAPTURE(threads);
       RepairCounts counts;
       const MaybePolytope r = morph::detail::run_with_threads(threads, [&] {
-        return erode_polytope(A, B, {.counts = &counts, .repair_regions_from = 1});
+        return erode_polytope(
+            A, B,
+            {.counts = &counts, .repair_regions_from = 1, .repair_regions_on_one_thread = true});
       });
       REQUIRE(r.polytope);
       CHECK(r.route == HullRoute::repaired);
