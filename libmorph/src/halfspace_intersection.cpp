@@ -1975,9 +1975,9 @@ class SurfaceRepair {
   void seed(const std::vector<std::pair<int, int>>& reflex, int triangles);
   /// Flips, removes and (`may_lift`) lifts until every edge is locally convex. A region's
   /// worker stops when none of its own can act, and keeps the edges it cannot act on for
-  /// `absorb`; without lifts, it keeps those that wait for its next run. The whole surface's
-  /// worker without lifts keeps the edges that wait for `hand_back`. False when the repair
-  /// fails.
+  /// `absorb`; without lifts, it keeps those that wait, to test again in its next run. The whole
+  /// surface's worker without lifts keeps the edges that wait for `hand_back`. False when the
+  /// repair fails.
   bool relax(bool may_lift = true);
   /// Hands the edges it kept to the regions' workers, each to its triangle's region's
   /// (RepairState::first).
@@ -2499,7 +2499,13 @@ bool SurfaceRepair::relax(bool may_lift) {
       if (waiting_.empty()) break;
       if (!progress && !(may_lift && lift_waiting())) {
         if (region_ < 0 && may_lift) return false;
-        if (region_ >= 0 && !may_lift) break;  // (they wait for its next run)
+        if (region_ >= 0 && !may_lift) {
+          // They are tested again first in its next run (the whole surface's pass between
+          // may have changed their neighbours).
+          queue_.assign(waiting_.rbegin(), waiting_.rend());
+          waiting_.clear();
+          break;
+        }
         deferred_.insert(deferred_.end(), waiting_.begin(), waiting_.end());
         waiting_.clear();
         break;
