@@ -1141,11 +1141,13 @@ TEST_CASE("halfspace_intersection: an erosion's guess near vertices of high degr
 }
 // Where the repair's flips get stuck: a UV sphere's rows of quadrilaterals near a pole that
 // vanish together (each has four neighbours; the flip across the row would make an inverted
-// triangle of three nearly collinear dual points, and no neighbour has three). The repair
-// lifts such planes off the surface, flips on, and inserts them again where they cut the
-// surface (here 4 lifts with one inserted back for the cube, 11 with one for the snub
-// dodecahedron); before, it gave up and the incremental hull ran. The result is the hull's
-// and the exact route's.
+// triangle of three nearly collinear dual points, and no neighbour has three). Such an
+// edge's folded end lies beneath the triangle of the other three planes, and the repair
+// takes it off at once, its neighbours' polygon made a fan (IntersectOptions::
+// remove_beneath). Without that, it lifts such planes off the surface when every edge is
+// stuck, flips on, and inserts them again where they cut the surface (here 4 lifts with one
+// inserted back for the cube, 11 with one for the snub dodecahedron); before either, it gave
+// up and the incremental hull ran. The result is the hull's and the exact route's.
 TEST_CASE("halfspace_intersection: an erosion's repair lifts planes its flips cannot reach") {
   struct Case {
     int n;
@@ -1166,12 +1168,21 @@ TEST_CASE("halfspace_intersection: an erosion's repair lifts planes its flips ca
     REQUIRE(r.polytope);
     CHECK(r.route == HullRoute::repaired);
     CHECK(r.polytope->num_faces() < A.num_faces());
-    // The repair lifted planes, and put back some that bound the result.
-    RepairCounts counts;
+    RepairCounts counts, lifting;
     CHECK(difference(erode_polytope(A, B, {.counts = &counts}), r) == "");
-    CHECK(counts.lifts > 0);
-    CHECK(counts.insertions > 0);
-    CHECK(counts.cuts > 0);
+    CHECK(counts.fan_removals > 0);
+    CHECK(counts.flips > 0);
+    // Without the fans, the repair lifts planes and puts back some that bound the result.
+    CHECK(difference(erode_polytope(A, B, {.counts = &lifting, .remove_beneath = false}), r) ==
+          "");
+    CHECK(lifting.fan_removals == 0);
+    CHECK(lifting.lifts > 0);
+    CHECK(lifting.insertions > 0);
+    CHECK(lifting.cuts > 0);
+    // The fans take off planes that flips, lifts and insertions took off before, and all that
+    // vanish are removed for good.
+    CHECK(counts.flips < lifting.flips);
+    CHECK(counts.lifts < lifting.lifts);
   }
 }
 
@@ -1180,12 +1191,13 @@ TEST_CASE("halfspace_intersection: an erosion's repair lifts planes its flips ca
 // 20.5 following a removed start's stale links, whose slots may have been taken anywhere;
 // climbs from triangle 0, often the opposite pole, took 163 at n = 320), and the check's
 // planes off the candidate at the previous plane's vertex or at the triangle over their dual
-// points (7.3). Counts, not times: the same on any machine.
+// points (7.3). Counts, not times: the same on any machine. (Lifts, hence insertions, are
+// rare since the repair removes the folded ends of stuck edges: here without that.)
 TEST_CASE("halfspace_intersection: planes put back walk a few triangles to their cones") {
   const Polytope A = make_operand(morph::make_uv_sphere(1.0, 120), "A");
   const Polytope B = make_operand(morph::test::cube(0.3), "B");
   RepairCounts counts;
-  const MaybePolytope r = erode_polytope(A, B, {.counts = &counts});
+  const MaybePolytope r = erode_polytope(A, B, {.counts = &counts, .remove_beneath = false});
   REQUIRE(r.polytope);
   CHECK(r.route == HullRoute::repaired);
   CHECK(difference(r, erode_polytope(A, B, {.guess = false})) == "");
@@ -1283,7 +1295,10 @@ TEST_CASE("halfspace_intersection: the huge-page allocator holds what it is give
 // decides as the planes' own filters and exact values do: the same flips, removals, lifts,
 // insertions and walks with it and without, and the same result. It decides nearly all
 // tests on an icosphere, and leaves to the planes those of four planes through one point or
-// nearly so (a UV sphere's nearly planar quadrilaterals, its poles).
+// nearly so (a UV sphere's nearly planar quadrilaterals, its poles), and orientations of
+// three normals in one plane through o (the icosphere's facets along its mirror planes,
+// which the fans of removed planes meet: 568 of 16,060 tests here, 328 of 22,633 with
+// lifts).
 TEST_CASE("halfspace_intersection: the dual points' filter decides as the planes do") {
   struct Case {
     morph::Mesh A, B;
@@ -1311,7 +1326,7 @@ TEST_CASE("halfspace_intersection: the dual points' filter decides as the planes
     CAPTURE(with.dual_undecided);
     CHECK(with.dual_decided > 10 * with.dual_undecided);
     if (c.well_conditioned)
-      CHECK(with.dual_decided > 50 * with.dual_undecided);
+      CHECK(with.dual_decided > 25 * with.dual_undecided);
     else
       CHECK(with.dual_undecided > 0);
   }
@@ -2241,14 +2256,15 @@ TEST_CASE("halfspace_intersection: the signs a guess takes from A's convexity ar
   }
 }
 
-// The planes a repair's 3-1 flips take off the surface lie strictly inside the result (see
+// The planes a repair removes from the surface — by a 3-1 flip, or as the folded end of an
+// edge that cannot flip, by a fan of its neighbours — lie strictly inside the result (see
 // DualSurface::inside): the check does not walk to them, and with verify_certified it does,
 // finding each strictly below the result's highest vertex along its normal. Here where
 // many vanish (a UV sphere's rows of quadrilaterals, an icosphere's facets near the arcs of
 // a small element's Gauss map), and on a cube with a chamfered edge whose chamfer an
 // octahedron of radius r makes vanish (chamfer width c < r) or leaves touching the result
 // along an edge (c = r: a plane through two vertices, not strictly inside).
-TEST_CASE("halfspace_intersection: the planes a 3-1 flip takes off stay strictly inside") {
+TEST_CASE("halfspace_intersection: the planes a repair removes stay strictly inside") {
   const auto chamfered = [](double c) {
     std::vector<morph::Point> p;
     for (double z : {-1.0, 1.0}) {
@@ -2265,6 +2281,12 @@ TEST_CASE("halfspace_intersection: the planes a 3-1 flip takes off stay strictly
   const Case cases[] = {
       {morph::make_uv_sphere(1.0, 40), morph::test::cube(0.3), true},
       {morph::make_icosphere(1.0, 4), morph::make_icosphere(0.25, 1), true},
+      {morph::make_uv_sphere(1.0, 66), morph::test::scaled(sample("snub_dodecahedron.off"), 0.25),
+       true},
+      {morph::test::random_sphere_polytope(2000, 21),
+       morph::test::transformed(morph::test::random_sphere_polytope(60, 22, 0.3),
+                                morph::test::random_rotation(23)),
+       true},
       {chamfered(0.125), morph::test::octahedron(0.25), false},
       {chamfered(0.25), morph::test::octahedron(0.25), false},
   };
@@ -2280,6 +2302,7 @@ TEST_CASE("halfspace_intersection: the planes a 3-1 flip takes off stay strictly
     CHECK(walked.certified_wrong == 0);
     CHECK(skipped.check_planes + skipped.removals == walked.check_planes);
     if (c.removes) CHECK(skipped.removals > 0);
+    if (c.removes) CHECK(skipped.fan_removals > 0);
   }
   // The chamfer vanishes, or touches the result along an edge.
   const Polytope B = make_operand(morph::test::octahedron(0.25), "B");

@@ -213,6 +213,7 @@ struct MaybePolytope {
 struct RepairCounts {
   long flips = 0;
   long removals = 0;
+  long fan_removals = 0;  // of those, planes of more than three neighbours (see remove_beneath)
   long lifts = 0;
   long insertions = 0;    // planes put back into a convex surface (lifted, or cutting it)
   long cuts = 0;          // of those, the ones that cut it (the others stay off)
@@ -237,6 +238,7 @@ struct RepairCounts {
   RepairCounts& operator+=(const RepairCounts& o) {
     flips += o.flips;
     removals += o.removals;
+    fan_removals += o.fan_removals;
     lifts += o.lifts;
     insertions += o.insertions;
     cuts += o.cuts;
@@ -282,6 +284,12 @@ struct IntersectOptions {
   // written are byte-identical. (On one thread the regions cost 1-8% more than one pass.)
   int repair_regions_from = 16384;
   bool repair_regions_on_one_thread = false;  // tests: the regions on one thread too
+  // A reflex edge that cannot flip (the flip would fold a triangle) has an end strictly
+  // beneath the triangle of the other three planes: the repair takes it off at once,
+  // whatever its number of neighbours. false: only an end of three neighbours is, the others
+  // wait, and stuck edges lift planes to insert again later (the repair up to session 26;
+  // tests keep that path covered). The result is the same polytope either way.
+  bool remove_beneath = true;
 };
 
 /// The exact value hi + lo of each coordinate.
