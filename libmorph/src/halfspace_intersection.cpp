@@ -2146,6 +2146,7 @@ class SurfaceRepair {
   int last_ = -1;  // where the last insertion's walk ended (a start when x's own is gone)
   // Scratch of lift and insert.
   std::vector<int> fan_, link_, outer_, visible_;
+  std::vector<int> rotated_, outer_rotated_;  // lift's fan: the neighbours from its apex on
   std::vector<char> clipped_, link_joined_;
   std::vector<std::array<int, 3>> ears_;
   std::vector<std::optional<HVertex>> ear_vertex_;  // computed where a test needed it
@@ -2231,20 +2232,22 @@ bool SurfaceRepair::lift(int t, int i, bool beneath_known) {
     // chosen one by one, as a lift's, walked around every neighbour and tested more:
     // icosphere level 7 by icosphere(0.25, 1), 4.58M tests in the repair against 1.97M,
     // and the erosion was slower than before this removal, 421 ms against 373.)
-    for (int z = 0; z < k && !fanned; ++z) {
+    // rotated_[j] is neighbour apex + j (mod k), outer_rotated_[j] the triangle across
+    // the polygon's edge from it to the next.
+    for (int apex = 0; apex < k && !fanned; ++apex) {
+      rotated_.resize(k);
+      for (int j = 0; j < k; ++j) rotated_[j] = link_[apex + j < k ? apex + j : apex + j - k];
       bool valid = true;
       for (int m = 1; m + 1 < k && valid; ++m)
-        valid = positive(link_[z], link_[(z + m) % k], link_[(z + m + 1) % k]);
+        valid = positive(rotated_[0], rotated_[m], rotated_[m + 1]);
       if (!valid) continue;
-      const int degree = around(fan_[z], link_[z], kMaxDegree, [&](int w) {
-        for (int m = 2; m + 1 < k; ++m)
-          if (link_[(z + m) % k] == w) valid = false;
+      const int degree = around(fan_[apex], rotated_[0], kMaxDegree, [&](int w) {
+        for (int m = 2; m + 1 < k; ++m) valid &= rotated_[m] != w;
       });
       if (degree > kMaxDegree || !valid) continue;
-      for (int m = 1; m + 1 < k; ++m) {
-        ears_.push_back({link_[z], link_[(z + m) % k], link_[(z + m + 1) % k]});
-        ear_vertex_.emplace_back();
-      }
+      outer_rotated_.resize(k);
+      for (int j = 0; j < k; ++j)
+        outer_rotated_[j] = outer_[apex + j < k ? apex + j : apex + j - k];
       fanned = true;
     }
   }
@@ -2333,12 +2336,28 @@ bool SurfaceRepair::lift(int t, int i, bool beneath_known) {
   // The ears in the first k - 2 fan slots: across a link edge z_m -> z_m+1 lies outer[m];
   // across a diagonal, the other ear along it.
   const int made = k - 2;
-  for (int r = 0; r < made; ++r) {
+  if (fanned) {
+    // Triangle r is (apex, z_r+1, z_r+2) counting from the apex: across its first edge the
+    // triangle before it, across its last the one after it, and the polygon's edges' outer
+    // triangles across those.
+    const std::vector<int>& z = rotated_;
+    for (int r = 0; r < made; ++r) make_triangle(fan_[r], {z[0], z[r + 1], z[r + 2]});
+    for (int r = 0; r < made; ++r) {
+      const int before = r == 0 ? outer_rotated_[0] : fan_[r - 1];
+      const int after = r == made - 1 ? outer_rotated_[k - 1] : fan_[r + 1];
+      s_.across[fan_[r]] = {before, outer_rotated_[r + 1], after};
+      if (!relink(outer_rotated_[r + 1], z[r + 2], z[r + 1], fan_[r])) return false;
+    }
+    if (!relink(outer_rotated_[0], z[1], z[0], fan_[0]) ||
+        !relink(outer_rotated_[k - 1], z[0], z[k - 1], fan_[made - 1]))
+      return false;
+  }
+  for (int r = 0; r < made && !fanned; ++r) {
     make_triangle(fan_[r], ears_[r]);
     if (ear_vertex_[r])
       s_.slot[fan_[r]] = s_.vertices.add_reusing(std::move(*ear_vertex_[r]), free_vertices_);
   }
-  for (int r = 0; r < made; ++r) {
+  for (int r = 0; r < made && !fanned; ++r) {
     for (int e = 0; e < 3; ++e) {
       const int p = ears_[r][e], q = ears_[r][next(e)];
       int to = -1;
