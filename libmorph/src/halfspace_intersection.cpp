@@ -4131,6 +4131,7 @@ int common_point(const KnownPoints& known, const int* p, int k) {
 /// Scratch space of triangulate_polygon, kept across the polygons of a chunk.
 struct PolygonScratch {
   std::vector<std::array<int, 3>> triangle;  // corners: positions in the polygon
+  std::vector<HVertex> vertex;               // each triangle's, where ready
   std::vector<char> ready;                   // whether its vertex is computed
   std::vector<std::pair<int, int>> pending;  // diagonals to test
   std::vector<V3<Interval>> cross;           // n_i x n_j of positions i, j (k i + j)
@@ -4191,13 +4192,11 @@ bool triangulate_polygon(const Planes& planes, const PrecisePlanes& precise,
   }
   if (!split) return false;
   auto& triangle = scratch.triangle;
-  // Each triangle's vertex, computed where it is ready, in the store from the start.
-  struct InStore {
-    VertexStore& store;
-    int first;
-    HVertex& operator[](int t) const { return store[first + t]; }
-  };
-  const InStore vertex{*store, store->add_range(k - 2)};
+  // Each triangle's vertex, computed where it is tested (ready); those go to the store at the
+  // end, the others are made where the check or the repair needs them.
+  auto& vertex = scratch.vertex;
+  vertex.clear();
+  vertex.resize(k - 2);
   auto& ready = scratch.ready;
   auto& pending = scratch.pending;
   triangle.clear();
@@ -4380,18 +4379,24 @@ bool triangulate_polygon(const Planes& planes, const PrecisePlanes& precise,
         pending.push_back(e);
       }
   }
-  // Every final triangle's vertex, for the check (the untested ones cheaply, from the
-  // cross products at hand; their orientation is left to the check).
+  // The tested triangles' vertices, for the check. (Each untested one was made here too, and
+  // stored: a UV sphere of 512 x 512 facets, 54 MB more of fresh vertex records, most of
+  // which the check's far-plane tests never read, deciding on the dual points. Its
+  // orientation is left to the check.)
+  int tested = 0;
   for (std::size_t t = 0; t < triangle.size(); ++t) {
     out[t] = {p[triangle[t][0]], p[triangle[t][1]], p[triangle[t][2]]};
     for (int m = 0; m < 3; ++m) {
       const int x = triangle[t][m], y = triangle[t][m == 2 ? 0 : m + 1];
       out_far[3 * t + m] = diagonal_side(x, y);  // (2 for the polygon's sides: never set)
     }
-    if (!ready[t]) compute_vertex(static_cast<int>(t));
+    tested += ready[t];
   }
-  for (std::size_t t = 0; t < triangle.size(); ++t)
-    out_slot[t] = vertex.first + static_cast<int>(t);
+  int next = tested > 0 ? store->add_range(tested) : 0;
+  for (std::size_t t = 0; t < triangle.size(); ++t) {
+    out_slot[t] = ready[t] ? next : -1;
+    if (ready[t]) (*store)[next++] = std::move(vertex[t]);
+  }
   return true;
 }
 
