@@ -2331,8 +2331,7 @@ bool SurfaceRepair::lift(int t, int i, bool beneath_known) {
       }
     }
   }
-  // The ears in the first k - 2 fan slots: across a link edge z_m -> z_m+1 lies outer[m];
-  // across a diagonal, the other ear along it.
+  // The ears in the first k - 2 fan slots.
   const int made = k - 2;
   if (fanned) {
     // Triangle r is (apex, z_r+1, z_r+2) counting from the apex: across its first edge the
@@ -2349,27 +2348,30 @@ bool SurfaceRepair::lift(int t, int i, bool beneath_known) {
     if (!relink(outer_rotated_[0], z[1], z[0], fan_[0]) ||
         !relink(outer_rotated_[k - 1], z[0], z[k - 1], fan_[made - 1]))
       return false;
-  }
-  for (int r = 0; r < made && !fanned; ++r) {
-    make_triangle(fan_[r], ears_[r]);
-    if (ear_vertex_[r])
-      s_.slot[fan_[r]] = s_.vertices.add_reusing(std::move(*ear_vertex_[r]), free_vertices_);
-  }
-  for (int r = 0; r < made && !fanned; ++r) {
-    for (int e = 0; e < 3; ++e) {
-      const int p = ears_[r][e], q = ears_[r][next(e)];
-      int to = -1;
-      for (int m = 0; m < k && to < 0; ++m)
-        if (link_[m] == p && link_[m + 1 == k ? 0 : m + 1] == q) {
-          if (!relink(outer_[m], q, p, fan_[r])) return false;
-          to = outer_[m];
+  } else {
+    // Across a link edge z_m -> z_m+1 lies outer[m]; across a diagonal, the other ear along
+    // it.
+    for (int r = 0; r < made; ++r) {
+      make_triangle(fan_[r], ears_[r]);
+      if (ear_vertex_[r])
+        s_.slot[fan_[r]] = s_.vertices.add_reusing(std::move(*ear_vertex_[r]), free_vertices_);
+    }
+    for (int r = 0; r < made; ++r) {
+      for (int e = 0; e < 3; ++e) {
+        const int p = ears_[r][e], q = ears_[r][next(e)];
+        int to = -1;
+        for (int m = 0; m < k && to < 0; ++m)
+          if (link_[m] == p && link_[m + 1 == k ? 0 : m + 1] == q) {
+            if (!relink(outer_[m], q, p, fan_[r])) return false;
+            to = outer_[m];
+          }
+        for (int o = 0; o < made && to < 0; ++o) {
+          const int j = slot_of(fan_[o], q);
+          if (o != r && j >= 0 && ears_[o][next(j)] == p) to = fan_[o];
         }
-      for (int o = 0; o < made && to < 0; ++o) {
-        const int j = slot_of(fan_[o], q);
-        if (o != r && j >= 0 && ears_[o][next(j)] == p) to = fan_[o];
+        if (to < 0) return false;
+        s_.across[fan_[r]][e] = to;
       }
-      if (to < 0) return false;
-      s_.across[fan_[r]][e] = to;
     }
   }
   kill(fan_[k - 2]);
