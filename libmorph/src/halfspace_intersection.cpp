@@ -3445,14 +3445,19 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
     std::vector<std::pair<int, int>> cutting;
     for (std::size_t j = 0; j < others.size(); ++j)
       if (cut[j] >= 0) cutting.emplace_back(others[j], triangle_of[cut[j]]);
-    // The triangles' vertices, where each is its own group; otherwise made again.
+    // The vertices of the triangles that are their own group; the others made again. (A UV
+    // sphere's pole is one group of many triangles: before, every vertex was made again
+    // then, and their precise coordinates.)
     if (identity) {
-      s.vertices = std::move(vertex.store);
       s.slot = std::move(vertex.index);
     } else {
-      s.vertices = VertexStore();
+      std::vector<int> members(nv, 0);
+      for (int t = 0; t < nt; ++t) ++members[group[t]];
       s.slot.assign(nt, -1);
+      for (int t = 0; t < nt; ++t)
+        if (members[group[t]] == 1) s.slot[t] = vertex.index[group[t]];
     }
+    s.vertices = std::move(vertex.store);
     s.far_side = std::move(far_side);
     RepairState state(nt, static_cast<int>(planes.size()));
     if (!SurfaceRepair(planes, precise, known, s, state, counts).insert_cutting(cutting))
