@@ -1173,8 +1173,7 @@ TEST_CASE("halfspace_intersection: an erosion's repair lifts planes its flips ca
     CHECK(counts.fan_removals > 0);
     CHECK(counts.flips > 0);
     // Without the fans, the repair lifts planes and puts back some that bound the result.
-    CHECK(difference(erode_polytope(A, B, {.counts = &lifting, .remove_beneath = false}), r) ==
-          "");
+    CHECK(difference(erode_polytope(A, B, {.counts = &lifting, .remove_beneath = false}), r) == "");
     CHECK(lifting.fan_removals == 0);
     CHECK(lifting.lifts > 0);
     CHECK(lifting.insertions > 0);
@@ -1314,7 +1313,7 @@ TEST_CASE("halfspace_intersection: the dual points' filter decides as the planes
     const Polytope A = make_operand(c.A, "A");
     const Polytope B = make_operand(c.B, "B");
     CAPTURE(A.num_faces());
-    RepairCounts with, without;
+    RepairCounts with, without, lifting, lifting_without;
     const MaybePolytope r = erode_polytope(A, B, {.counts = &with});
     REQUIRE(r.polytope);
     CHECK(r.route == HullRoute::repaired);
@@ -1322,13 +1321,26 @@ TEST_CASE("halfspace_intersection: the dual points' filter decides as the planes
     CHECK(with.flips > 0);
     check_same_actions(with, without);
     CHECK(without.dual_decided + without.dual_undecided == 0);
+    // The repair that lifts (no fans) likewise.
+    CHECK(difference(erode_polytope(A, B, {.counts = &lifting, .remove_beneath = false}), r) == "");
+    CHECK(
+        difference(
+            erode_polytope(
+                A, B, {.counts = &lifting_without, .dual_filter = false, .remove_beneath = false}),
+            r) == "");
+    check_same_actions(lifting, lifting_without);
     CAPTURE(with.dual_decided);
     CAPTURE(with.dual_undecided);
+    CAPTURE(lifting.dual_decided);
+    CAPTURE(lifting.dual_undecided);
     CHECK(with.dual_decided > 10 * with.dual_undecided);
-    if (c.well_conditioned)
-      CHECK(with.dual_decided > 25 * with.dual_undecided);
-    else
+    CHECK(lifting.dual_decided > 10 * lifting.dual_undecided);
+    if (c.well_conditioned) {
+      CHECK(lifting.dual_decided > 50 * lifting.dual_undecided);
+      CHECK(with.dual_decided > 25 * with.dual_undecided);  // (the fans' mirror-plane triples)
+    } else {
       CHECK(with.dual_undecided > 0);
+    }
   }
 }
 
