@@ -1218,7 +1218,7 @@ TEST_CASE("halfspace_intersection: planes put back walk a few triangles to their
 // passes over the whole surface): the same polytope, field by field, as one pass over the
 // whole surface, on one thread or two, with the same actions whatever the threads. Here
 // the regions are forced on small surfaces and on one thread (repair_regions_from 1,
-// repair_regions_on_one_thread); a UV sphere's poles gather the lifts into two of them.
+// repair_regions_on_one_thread); a UV sphere's poles gather the work into two of them.
 TEST_CASE("halfspace_intersection: a repair in regions gives the whole surface's result") {
   struct Case {
     morph::Mesh A, B;

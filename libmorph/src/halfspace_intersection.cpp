@@ -443,8 +443,9 @@ struct DualSurface {
   // neighbours.
   bool oriented = false;
   std::vector<signed char> far_side;
-  // Empty, or per plane: 1 where a repair's 3-1 flip took it off the surface. Its dual
-  // point then lay strictly beneath its three neighbours' triangle, in that triangle's cone:
+  // Empty, or per plane: 1 where a repair removed it from the surface (a 3-1 flip, or a fan
+  // of its neighbours where a flip would fold). Its dual point then lay strictly beneath
+  // the triangle of three of its neighbours' planes, in that triangle's cone:
   // strictly inside the hull of o and dual points that end on the surface or inside its
   // hull, and o is strictly inside that hull; so its plane neither cuts nor touches the
   // result, and the check does not walk to it (see SurfaceRepair::remove).
@@ -3333,7 +3334,7 @@ std::optional<MaybePolytope> build_verified(const HalfSpaces& hs, const Planes& 
   // vertices of A), the climb starts there and usually ends at once; where it does not, at
   // the chunk's last vertex. The result does not depend on the start. Two vertices both
   // known on the plane compare equal without arithmetic.
-  // (Not those a repair's 3-1 flips took off, strictly inside: see DualSurface::inside;
+  // (Not those a repair removed, strictly inside: see DualSurface::inside;
   // with options.verify_certified, those too, each that is not strictly inside counted.)
   std::vector<int> others;
   const auto certified_inside = [&](int p) { return !s.inside.empty() && s.inside[p]; };

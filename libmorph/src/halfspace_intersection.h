@@ -226,7 +226,7 @@ struct RepairCounts {
   long dual_undecided = 0;
   // A guess's signs taken without a test (ExpectedVertices::fans_of_operand, moved_by):
   // triangle orientations and far-plane signs. With IntersectOptions::verify_certified, the
-  // signs taken, and planes a repair's 3-1 flips took off (not walked to), that the tests
+  // signs taken, and planes a repair removed (3-1 flips, fans; not walked to), that the tests
   // then made found otherwise (none, or the argument is wrong).
   long certified = 0;
   long certified_wrong = 0;
@@ -274,7 +274,7 @@ struct IntersectOptions {
   // false: the guess's signs that ExpectedVertices makes certain are tested like
   // any other (tests compare). verify_certified: they are skipped, and also tested, each
   // different sign counted (RepairCounts::certified_wrong; tests); so are the planes a
-  // repair's 3-1 flips took off (always certain, not walked to: DualSurface::inside).
+  // repair removed (3-1 flips, fans: always certain, not walked to: DualSurface::inside).
   bool certify = true;
   bool verify_certified = false;
   // A guess's repair runs first in six regions, in parallel, when it has at least this many
