@@ -434,8 +434,9 @@ TEST_CASE("halfspace_intersection: known points and an expected result give the 
 }
 
 // A guess whose triangles do not close into a surface (a vertex's polygon left out, one
-// given twice, one turned round) is given up when its triangles are paired across their
-// edges (each edge a -> b with a < b searched once, setting its reverse too): the hull
+// given twice, one turned round) is given up when its triangles are joined across their
+// polygons' sides (each side a -> b with a < b searched once, joining its reverse too; or,
+// with the edges given, two sides of one edge whose planes are not reversed): the hull
 // computes the result, the same.
 TEST_CASE("halfspace_intersection: a guess that is not a closed surface is given up") {
   const HalfSpaces hs = planes_through_apex(12);
@@ -473,6 +474,37 @@ TEST_CASE("halfspace_intersection: a guess that is not a closed surface is given
   for (std::size_t k = 0; k < broken.size(); ++k) {
     CAPTURE(k);
     const MaybePolytope got = intersect_halfspaces(hs, {0, 0, 0}, {}, {}, guess_of(broken[k]));
+    CHECK(got.route != HullRoute::expected);
+    CHECK(got.route != HullRoute::repaired);
+    CHECK(difference(got, plain) == "");
+  }
+  // The same fans joined by their edges (erode_polytope's way): taken whole; a fan turned
+  // round (its sides' edges with it), or an edge out of range, given up.
+  const auto with_edges = [&](ExpectedVertices e, int turned) {
+    for (int v = 0; v < nv; ++v) {
+      std::vector<int> edge(p.fan_edge.begin() + p.fan_begin[v],
+                            p.fan_edge.begin() + p.fan_begin[v + 1]);
+      // Side i of a fan turned round lies between its facets k - 1 - i and k - 2 - i.
+      if (v == turned) {
+        const int k = static_cast<int>(edge.size());
+        std::vector<int> r(k);
+        for (int i = 0; i < k; ++i) r[i] = edge[(2 * k - 2 - i) % k];
+        edge = r;
+      }
+      e.edge.insert(e.edge.end(), edge.begin(), edge.end());
+    }
+    e.edges = p.num_edges();
+    return e;
+  };
+  const MaybePolytope joined =
+      intersect_halfspaces(hs, {0, 0, 0}, {}, {}, with_edges(guess_of(fans), -1));
+  CHECK(joined.route == HullRoute::expected);
+  CHECK(difference(joined, plain) == "");
+  ExpectedVertices out_of_range = with_edges(guess_of(fans), -1);
+  out_of_range.edge[0] = out_of_range.edges;
+  ExpectedVertices turned = with_edges(guess_of(broken[2]), 1);
+  for (const ExpectedVertices& e : {out_of_range, turned}) {
+    const MaybePolytope got = intersect_halfspaces(hs, {0, 0, 0}, {}, {}, e);
     CHECK(got.route != HullRoute::expected);
     CHECK(got.route != HullRoute::repaired);
     CHECK(difference(got, plain) == "");

@@ -433,9 +433,13 @@ MaybePolytope erode_polytope(const Polytope& A, const Polytope& B,
   // Facet f of A is half-space f: A's fans are the polygons of the guess. The input is
   // shared with the result, whose lazy exact points (an opening) read its planes and known
   // points rather than copies.
-  const auto in = std::make_shared<const ErosionInput>(erosion_input(
-      A, B, SumOfB::no,
-      {.begin = A.fan_begin, .facets = A.fan_face, .fans_of_operand = true, .moved_by = {}}));
+  const auto in = std::make_shared<const ErosionInput>(erosion_input(A, B, SumOfB::no,
+                                                                     {.begin = A.fan_begin,
+                                                                      .facets = A.fan_face,
+                                                                      .fans_of_operand = true,
+                                                                      .moved_by = {},
+                                                                      .edge = A.fan_edge,
+                                                                      .edges = A.num_edges()}));
   return intersect_halfspaces(in->halfspaces, in->hint, options, in->known, in->expected, in);
 }
 
@@ -455,6 +459,8 @@ ErosionInput erode_sum_input(const Polytope& S, const Polytope& A, const Polytop
     expected.split = false;
     expected.facets.reserve(A.fan_face.size());
     for (int f : A.fan_face) expected.facets.push_back(facet_of[f]);
+    expected.edge = A.fan_edge;
+    expected.edges = A.num_edges();
   }
   return erosion_input(S, B, S.sum_pairs.empty() ? SumOfB::no : SumOfB::yes, std::move(expected));
 }
@@ -727,6 +733,8 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
   in.expected.begin = A.fan_begin;
   in.expected.split = false;
   in.expected.facets = A.fan_face;
+  in.expected.edge = A.fan_edge;
+  in.expected.edges = A.num_edges();
   // The hint erode gives S: its vertex centroid (the rounded sums) minus B's.
   V3<double> ca{0, 0, 0}, cb{0, 0, 0};
   for (const std::uint64_t key : pairs) {

@@ -4181,21 +4181,32 @@ constexpr int kFlipsPerCorner = 4;
 /// with its final triangles, or for a diagonal a flip made, -1 (the flipped test's four
 /// planes in an odd order: the opposite sign, and it was positive); 0 for planes through
 /// one known point (four planes through a point).
+/// The triangles are numbered from `base` on the surface: each diagonal's two triangles are
+/// joined in out_across (3 per triangle; the polygon's sides are left as they are), and side
+/// i of the polygon, p[i] -> p[i + 1] (cyclically), is the directed edge out_side[i] =
+/// 3 t + m of the surface (triangle t, corner m to m + 1).
 /// Needs a RoundingGuard.
 bool triangulate_polygon(const Planes& planes, const PrecisePlanes& precise,
                          const KnownPoints& known, const V3<double>& o, const int* p, int k,
-                         bool split, std::array<int, 3>* out, VertexStore* store, int* out_slot,
-                         signed char* out_far, PolygonScratch& scratch) {
+                         bool split, int base, std::array<int, 3>* out,
+                         std::array<int, 3>* out_across, int* out_side, VertexStore* store,
+                         int* out_slot, signed char* out_far, PolygonScratch& scratch) {
   // Planes through one known point (facets of A moved by one vertex of B): one vertex.
   if (k == 3 || common_point(known, p, k) >= 0) {
     for (int i = 1; i + 1 < k; ++i) {
-      out[i - 1] = {p[0], p[i], p[i + 1]};
+      const int t = i - 1;
+      out[t] = {p[0], p[i], p[i + 1]};
       // The diagonals: (p[0], p[i]) and (p[i + 1], p[0]) where they are not polygon edges.
-      signed char* f = out_far + 3 * (i - 1);
+      signed char* f = out_far + 3 * t;
       f[0] = i > 1 ? 0 : 2;
       f[1] = 2;
       f[2] = i + 2 < k ? 0 : 2;
+      if (i > 1) out_across[t][0] = base + t - 1;
+      if (i + 2 < k) out_across[t][2] = base + t + 1;
+      out_side[i] = 3 * (base + t) + 1;
     }
+    out_side[0] = 3 * base;
+    out_side[k - 1] = 3 * (base + k - 3) + 2;
     return true;
   }
   if (!split) return false;
@@ -4397,6 +4408,10 @@ bool triangulate_polygon(const Planes& planes, const PrecisePlanes& precise,
     for (int m = 0; m < 3; ++m) {
       const int x = triangle[t][m], y = triangle[t][m == 2 ? 0 : m + 1];
       out_far[3 * t + m] = diagonal_side(x, y);  // (2 for the polygon's sides: never set)
+      if (diagonal(x, y))
+        out_across[t][m] = base + (owner[y * k + x] >> 2);
+      else
+        out_side[x] = 3 * (base + static_cast<int>(t)) + m;  // (y is x + 1: a side)
     }
     tested += ready[t];
   }
@@ -4488,11 +4503,18 @@ DualSurface expected_surface(const Planes& planes, const PrecisePlanes& precise,
     s.vertices.reserve(nt);  // (room for all: made on several threads)
   }
   s.far_side.resize(3 * static_cast<std::size_t>(nt));
+  // Each polygon joins its own triangles across its diagonals, and names the surface's
+  // directed edge 3 t + k (corner k to k + 1 of triangle t) on each of its sides: side i of
+  // polygon v, facets[begin[v] + i] -> facets[begin[v] + i + 1], is side[begin[v] + i].
+  s.across.assign(nt, {-1, -1, -1});
+  const std::size_t sides = expected.facets.size();
+  const auto side = std::make_unique_for_overwrite<int[]>(sides);
   std::atomic<bool> ok = true;
   const auto triangulate = [&](int v, PolygonScratch& scratch) {
-    if (!triangulate_polygon(planes, precise, known, o, &expected.facets[expected.begin[v]],
-                             expected.begin[v + 1] - expected.begin[v], expected.split,
-                             &s.corner[first[v]], &s.vertices,
+    const int b = expected.begin[v];
+    if (!triangulate_polygon(planes, precise, known, o, &expected.facets[b],
+                             expected.begin[v + 1] - b, expected.split, first[v],
+                             &s.corner[first[v]], &s.across[first[v]], &side[b], &s.vertices,
                              expected.split ? &s.slot[first[v]] : nullptr,
                              &s.far_side[3 * static_cast<std::size_t>(first[v])], scratch))
       ok = false;
@@ -4503,43 +4525,67 @@ DualSurface expected_surface(const Planes& planes, const PrecisePlanes& precise,
     for (int v = begin; v < end && ok; ++v) triangulate(v, scratch);
   });
   if (!ok) return {};
-  // Directed edges 3 t + k (corner k to k + 1 of triangle t) listed by their first plane
-  // (a counting sort), each with its second plane: each edge's reverse is the one edge back
-  // among the few leaving its second plane. Only edges a -> b with a < b search (the search's
-  // variable length cost a mispredicted exit each); each sets its reverse's `across` too.
-  // Every edge has exactly one reverse (a closed surface, each edge used once) iff each
-  // search finds exactly one, every edge b -> a with b > a is reached, and there are as many
-  // of those as of the searching ones (then the searches pair them one to one).
   const auto next_corner = [](int k) { return k == 2 ? 0 : k + 1; };
-  // (Each edge's head beside it: a search reads one array. Not zeroed: all are written.)
-  struct OutEdge {
-    int head, edge;
+  // The sides' planes: a -> b of directed edge e (corner e % 3 of triangle e / 3).
+  const auto tail = [&](int e) { return s.corner[e / 3][e % 3]; };
+  const auto head = [&](int e) { return s.corner[e / 3][next_corner(e % 3)]; };
+  // Joins directed edges e and r (r is e's reverse). (Atomic: two searches may reach one
+  // side where the surface is not closed.)
+  const auto join = [&](int e, int r) {
+    std::atomic_ref<int>(s.across[e / 3][e % 3]).store(r / 3, std::memory_order_relaxed);
+    std::atomic_ref<int>(s.across[r / 3][r % 3]).store(e / 3, std::memory_order_relaxed);
   };
-  std::vector<int> out_begin(planes.size() + 1, 0);
-  const auto out = std::make_unique_for_overwrite<OutEdge[]>(3 * static_cast<std::size_t>(nt));
-  std::ptrdiff_t balance = 0;  // edges a -> b with a < b, less those with a > b
-  for (const auto& c : s.corner)
-    for (int k = 0; k < 3; ++k) {
-      ++out_begin[c[k] + 1];
-      const int a = c[k], b = c[next_corner(k)];
-      if (a == b) return {};
+  if (expected.edge.size() == sides) {
+    // Each side is an edge of the operand (ExpectedVertices::edge), on two sides reversed:
+    // whichever of the two comes second joins them. (Checked: the reverse planes, and below,
+    // every edge joined.)
+    std::vector<int> seen(expected.edges, -1);
+    parallel_chunks(static_cast<int>(sides), 2048, [&](int begin, int end) {
+      for (int i = begin; i < end && ok; ++i) {
+        const int e = expected.edge[i];
+        if (e < 0 || e >= expected.edges) {
+          ok = false;
+          break;
+        }
+        const int r = std::atomic_ref<int>(seen[e]).exchange(side[i], std::memory_order_relaxed);
+        if (r < 0) continue;
+        if (tail(r) != head(side[i]) || head(r) != tail(side[i])) {
+          ok = false;
+          break;
+        }
+        join(side[i], r);
+      }
+    });
+  } else {
+    // Sides listed by their first plane (a counting sort), each with its second plane: each
+    // side's reverse is the one side back among the few leaving its second plane. Only
+    // sides a -> b with a < b search (the search's variable length cost a mispredicted exit
+    // each); each joins its reverse too. Every side has exactly one reverse (a closed
+    // surface, each edge used once) iff each search finds exactly one, every side b -> a
+    // with b > a is reached, and there are as many of those as of the searching ones (then
+    // the searches pair them one to one).
+    // (Each side's head beside it: a search reads one array. Not zeroed: all are written.)
+    struct OutEdge {
+      int head, edge;
+    };
+    std::vector<int> out_begin(planes.size() + 1, 0);
+    const auto out = std::make_unique_for_overwrite<OutEdge[]>(sides);
+    std::ptrdiff_t balance = 0;  // sides a -> b with a < b, less those with a > b
+    for (std::size_t i = 0; i < sides; ++i) {
+      const int a = tail(side[i]), b = head(side[i]);
+      ++out_begin[a + 1];
       balance += a < b ? 1 : -1;
     }
-  if (balance != 0) return {};
-  std::partial_sum(out_begin.begin(), out_begin.end(), out_begin.begin());
-  {
-    std::vector<int> next(out_begin.begin(), out_begin.end() - 1);
-    for (int t = 0; t < nt; ++t)
-      for (int k = 0; k < 3; ++k) {
-        out[next[s.corner[t][k]]++] = {s.corner[t][next_corner(k)], 3 * t + k};
-      }
-  }
-  s.across.assign(nt, {-1, -1, -1});
-  parallel_chunks(nt, 1024, [&](int begin, int end) {
-    for (int t = begin; t < end && ok; ++t)
-      for (int k = 0; k < 3; ++k) {
-        const int a = s.corner[t][k], b = s.corner[t][next_corner(k)];
-        if (a > b) continue;  // set by its reverse's search
+    if (balance != 0) return {};
+    std::partial_sum(out_begin.begin(), out_begin.end(), out_begin.begin());
+    {
+      std::vector<int> next(out_begin.begin(), out_begin.end() - 1);
+      for (std::size_t i = 0; i < sides; ++i) out[next[tail(side[i])]++] = {head(side[i]), side[i]};
+    }
+    parallel_chunks(static_cast<int>(sides), 1024, [&](int begin, int end) {
+      for (int i = begin; i < end && ok; ++i) {
+        const int a = tail(side[i]), b = head(side[i]);
+        if (a > b) continue;  // joined by its reverse's search
         int back = -1, found = 0;
         for (int j = out_begin[b]; j < out_begin[b + 1]; ++j)
           if (out[j].head == a) back = out[j].edge, ++found;
@@ -4547,14 +4593,16 @@ DualSurface expected_surface(const Planes& planes, const PrecisePlanes& precise,
           ok = false;  // an open surface, or an edge used twice
           break;
         }
-        s.across[t][k] = back / 3;
-        // (Atomic: two searches reach one edge where the surface is not closed.)
-        std::atomic_ref<int>(s.across[back / 3][back % 3]).store(t, std::memory_order_relaxed);
+        join(side[i], back);
       }
-  });
+    });
+  }
   if (!ok) return {};
-  for (const auto& u : s.across)
-    if (u[0] < 0 || u[1] < 0 || u[2] < 0) return {};
+  // Closed: every edge joined; and no triangle has a plane twice (a polygon that does).
+  for (int t = 0; t < nt; ++t) {
+    const auto &u = s.across[t], &c = s.corner[t];
+    if (u[0] < 0 || u[1] < 0 || u[2] < 0 || c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) return {};
+  }
   if (expected.fans_of_operand && options.certify)
     certify(planes, precise, known, expected, first, s, options);
   return s;

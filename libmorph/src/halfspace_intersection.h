@@ -365,6 +365,12 @@ struct ExpectedVertices {
   // strictly above that vertex (A's vertex v strictly below every facet not at v): certain,
   // not tested.
   std::vector<int> moved_by;
+  // Empty, or per slot of `facets` the operand's edge between that slot's facet and the
+  // next (Polytope::fan_edge), each of the `edges` edges in exactly two slots, once each
+  // way round (as in a polytope's fans): the guess then joins its polygons by edge, with no
+  // search for each side's reverse.
+  std::vector<int> edge;
+  int edges = 0;
   bool empty() const { return begin.empty(); }
 };
 
