@@ -166,8 +166,50 @@ Interval neighbours_interval(const DD& c) {
   return c.hi > 0 ? Interval(toward, away) : Interval(away, toward);
 }
 
-Planes planes_of(const HalfSpaces& hs) {
+/// The planes' dual points about an interior point o, p = n / (d - <n, o>), in doubles, each
+/// coordinate within `error` of the exact one (negative: no copy): a filter for the tests
+/// of four planes that flips make. The side of plane i at the vertex of planes a, b, c is
+/// the sign of det(p_b - p_i, p_a - p_i, p_c - p_i) (with o at the origin, the plane through
+/// p_a, p_b, p_c is {q : <q, y> = 1} for their vertex y, and det(p_a, p_b, p_c) > 0), and
+/// det(n_a, n_b, n_c) has the sign of det(p_a, p_b, p_c) (each p a positive multiple of its
+/// n). It reads 32 bytes a plane, where the exact tests read a Plane (about 150 bytes) and
+/// make a 208-byte vertex per triangle, most of them dropped again by the next flip.
+struct DualPoint {
+  V3<double> p;
+  double error = -1;
+};
+using DualPoints = std::vector<DualPoint>;  // (one array: one cache line a point)
+
+/// Plane q's dual point about o, or none (error -1). The error bound (any rounding mode; u = 2^-52
+/// an operation, 2 u an input: nd and dd are within an ulp of the exact n and d, as for the double
+/// filter): e = d - <n, o> is computed within E = 8 u (|dd| + <|nd|, |o|> + |e|) (two u for dd,
+/// seven for the dot product and its inputs, one for the difference); each coordinate n_j / e is
+/// then within (2 u + u + E / e) of itself relative, taken as 1.25 times that, plus 2^-1073 / e for
+/// a normal component below the subnormal range. A plane gets a copy only when e > 0 with E <=
+/// 2^-20 e and |n|, d and p within [2^-300, 2^300] or 0: a determinant of the points or their
+/// differences (below 2^301) then stays below 2^910 (no overflow), and what its products lose to
+/// underflow (2^-1074 each, times at most 2^301) is within kDoubleFloor.
+DualPoint dual_point(const Plane& q, const V3<double>& o) {
+  constexpr double u = 0x1p-52, kLow = 0x1p-300, kHigh = 0x1p300;
+  const V3<double> na = q.na();
+  const auto sane = [&](double x) { return x == 0 || (x >= kLow && x <= kHigh); };
+  if (!q.fast || !sane(na.x) || !sane(na.y) || !sane(na.z) || !sane(q.da())) return {};
+  const double m = na.x * std::abs(o.x) + na.y * std::abs(o.y) + na.z * std::abs(o.z);
+  const double e = q.dd - dot(q.nd, o);
+  const double E = 8 * u * (q.da() + m + std::abs(e));
+  if (!(e > 0) || E > 0x1p-20 * e) return {};
+  const V3<double> p{q.nd.x / e, q.nd.y / e, q.nd.z / e};
+  const double big = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+  if (!sane(std::abs(p.x)) || !sane(std::abs(p.y)) || !sane(std::abs(p.z))) return {};
+  return {p, 1.25 * (2 * u + u + E / e) * big + 0x1p-1073 / e};
+}
+
+/// A plane per half-space; with `dual`, also each one's dual point about *about (made here,
+/// while the plane is at hand, rather than in a second pass over all of them).
+Planes planes_of(const HalfSpaces& hs, const V3<double>* about = nullptr,
+                 DualPoints* dual = nullptr) {
   Planes planes(hs.size());
+  if (dual) dual->resize(hs.size());
   parallel_chunks(static_cast<int>(hs.size()), 256, [&](int begin, int end) {
     RoundingGuard guard;
     for (int i = begin; i < end; ++i) {
@@ -199,6 +241,7 @@ Planes planes_of(const HalfSpaces& hs) {
       }
       p.di = unit && h.has_offset_dd ? neighbours_interval(h.offset_dd) : to_interval_n(p.d());
       set_doubles(p);
+      if (dual) (*dual)[i] = dual_point(p, *about);
     }
   });
   return planes;
@@ -407,20 +450,6 @@ class VertexStore {
   std::atomic<std::size_t> size_{0};
   std::mutex grow_;
 };
-
-/// The planes' dual points about an interior point o, p = n / (d - <n, o>), in doubles, each
-/// coordinate within `error` of the exact one (negative: no copy): a filter for the tests
-/// of four planes that flips make. The side of plane i at the vertex of planes a, b, c is
-/// the sign of det(p_b - p_i, p_a - p_i, p_c - p_i) (with o at the origin, the plane through
-/// p_a, p_b, p_c is {q : <q, y> = 1} for their vertex y, and det(p_a, p_b, p_c) > 0), and
-/// det(n_a, n_b, n_c) has the sign of det(p_a, p_b, p_c) (each p a positive multiple of its
-/// n). It reads 32 bytes a plane, where the exact tests read a Plane (about 150 bytes) and
-/// make a 208-byte vertex per triangle, most of them dropped again by the next flip.
-struct DualPoint {
-  V3<double> p;
-  double error = -1;
-};
-using DualPoints = std::vector<DualPoint>;  // (one array: one cache line a point)
 
 /// A candidate dual hull: triangles over plane indices, counter-clockwise seen from
 /// outside, and the triangle across each edge (edge k runs from corner k to corner k + 1).
@@ -1381,36 +1410,13 @@ int det_sign(const Planes& planes, const PrecisePlanes& precise, int a, int b, i
   return CGAL::sign(det(pa.n(), pb.n(), pc.n()));
 }
 
-/// The dual points' error bounds (any rounding mode; u = 2^-52 an operation, 2 u an input:
-/// nd and dd are within an ulp of the exact n and d, as for the double filter): e = d - <n, o>
-/// is computed within E = 8 u (|dd| + <|nd|, |o|> + |e|) (two u for dd, seven for the dot
-/// product and its inputs, one for the difference); each coordinate n_j / e is then within
-/// (2 u + u + E / e) of itself relative, taken as 1.25 times that, plus 2^-1073 / e for a
-/// normal component below the subnormal range. A plane gets a copy only when e > 0 with
-/// E <= 2^-20 e and |n|, d and p within [2^-300, 2^300] or 0: a determinant of the points
-/// or their differences (below 2^301) then stays below 2^910 (no overflow), and what its
-/// products lose to underflow (2^-1074 each, times at most 2^301) is within kDoubleFloor.
+/// The planes' dual points about o (planes_of makes them with the planes when o is known
+/// then; otherwise made here, upward rounding).
 DualPoints dual_points(const Planes& planes, const V3<double>& o) {
-  constexpr double u = 0x1p-52, kLow = 0x1p-300, kHigh = 0x1p300;
-  DualPoints out;
-  const int n = static_cast<int>(planes.size());
-  out.resize(n);
-  parallel_chunks(n, 1024, [&](int begin, int end) {
+  DualPoints out(planes.size());
+  parallel_chunks(static_cast<int>(planes.size()), 1024, [&](int begin, int end) {
     RoundingGuard guard;
-    for (int k = begin; k < end; ++k) {
-      const Plane& q = planes[k];
-      const V3<double> na = q.na();
-      const auto sane = [&](double x) { return x == 0 || (x >= kLow && x <= kHigh); };
-      if (!q.fast || !sane(na.x) || !sane(na.y) || !sane(na.z) || !sane(q.da())) continue;
-      const double m = na.x * std::abs(o.x) + na.y * std::abs(o.y) + na.z * std::abs(o.z);
-      const double e = q.dd - dot(q.nd, o);
-      const double E = 8 * u * (q.da() + m + std::abs(e));
-      if (!(e > 0) || E > 0x1p-20 * e) continue;
-      const V3<double> p{q.nd.x / e, q.nd.y / e, q.nd.z / e};
-      const double big = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
-      if (!sane(std::abs(p.x)) || !sane(std::abs(p.y)) || !sane(std::abs(p.z))) continue;
-      out[k] = {p, 1.25 * (2 * u + u + E / e) * big + 0x1p-1073 / e};
-    }
+    for (int k = begin; k < end; ++k) out[k] = dual_point(planes[k], o);
   });
   return out;
 }
@@ -4615,10 +4621,15 @@ MaybePolytope intersect_halfspaces(const HalfSpaces& hs, const V3<double>& hint,
                                    const ExpectedVertices& expected,
                                    std::shared_ptr<const void> owner) {
   MaybePolytope out;
-  const Planes planes = planes_of(hs);
+  // (The guess's dual points made with the planes, about the hint: usually the centre.)
+  const bool guess_filter =
+      options.incremental && options.guess && !expected.empty() && options.dual_filter;
+  DualPoints dual;
+  const Planes planes = planes_of(hs, &hint, guess_filter ? &dual : nullptr);
   V3<Exact> o = to_exact(hint);
   V3<double> o_double = hint;
   if (!strictly_inside(planes, hint)) {
+    dual.clear();
     const CentreResult c = exact_centre(hs);
     if (c.t < 0) {
       out.reason = EmptyReason::empty;
@@ -4642,7 +4653,8 @@ MaybePolytope intersect_halfspaces(const HalfSpaces& hs, const V3<double>& hint,
     bool repaired = false;
     DualSurface guess = expected_surface(planes, precise, known, expected, o_double, options);
     if (options.dual_filter && !guess.corner.empty())
-      guess.dual = std::make_shared<const DualPoints>(dual_points(planes, o_double));
+      guess.dual = std::make_shared<const DualPoints>(dual.empty() ? dual_points(planes, o_double)
+                                                                   : std::move(dual));
     if (auto built = build_verified(hs, planes, precise, known, std::move(guess), options, owner,
                                     &repaired)) {
       built->route = repaired ? HullRoute::repaired : HullRoute::expected;
