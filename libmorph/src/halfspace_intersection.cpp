@@ -4168,6 +4168,58 @@ struct PolygonScratch {
 /// planes, mostly in its rounds over the waiting edges.)
 constexpr int kFlipsPerCorner = 4;
 
+/// triangulate_polygon's steps for a quadrilateral of fast planes that do not meet in a
+/// known point (a UV sphere's vertex: most of its polygons), without its scratch: one
+/// diagonal, (p0, p2), tested at the vertex of (p0, p2, p3) and flipped to (p1, p3) when
+/// plane p1 cuts it off. The same triangles, slots, signs and vertex as the general steps.
+bool triangulate_quadrilateral(const Planes& planes, const PrecisePlanes& precise,
+                               const KnownPoints& known, const int* p, int base,
+                               std::array<int, 3>* out, std::array<int, 3>* out_across,
+                               int* out_side, VertexStore* store, int* out_slot,
+                               signed char* out_far) {
+  HVertex v = vertex_of(planes, {p[0], p[2], p[3]});  // (the double filter's: all fast)
+  take_known(known, v);
+  if (!w_positive(v) && det_sign(planes, precise, p[0], p[2], p[3]) <= 0) return false;
+  const int sd = known_through(known, p[1], v) ? 0 : side(planes, precise, p[1], v);
+  const auto set_far = [&](int t, signed char f0, signed char f1, signed char f2) {
+    out_far[3 * t] = f0;
+    out_far[3 * t + 1] = f1;
+    out_far[3 * t + 2] = f2;
+  };
+  if (sd <= 0) {
+    // (p0, p1, p2) and (p0, p2, p3), the latter's vertex kept.
+    out[0] = {p[0], p[1], p[2]};
+    out[1] = {p[0], p[2], p[3]};
+    set_far(0, 2, 2, static_cast<signed char>(sd));
+    set_far(1, static_cast<signed char>(sd), 2, 2);
+    out_across[0][2] = base + 1;
+    out_across[1][0] = base;
+    out_side[0] = 3 * base;
+    out_side[1] = 3 * base + 1;
+    out_side[2] = 3 * (base + 1) + 1;
+    out_side[3] = 3 * (base + 1) + 2;
+    const int slot = store->add_range(1);
+    (*store)[slot] = std::move(v);
+    out_slot[0] = -1;
+    out_slot[1] = slot;
+    return true;
+  }
+  // Flipped: (p1, p2, p3) and (p0, p1, p3); the new diagonal's sign the opposite of the
+  // test's, and neither vertex made.
+  out[0] = {p[1], p[2], p[3]};
+  out[1] = {p[0], p[1], p[3]};
+  set_far(0, 2, 2, -1);
+  set_far(1, 2, -1, 2);
+  out_across[0][2] = base + 1;
+  out_across[1][1] = base;
+  out_side[0] = 3 * (base + 1);
+  out_side[1] = 3 * base;
+  out_side[2] = 3 * base + 1;
+  out_side[3] = 3 * (base + 1) + 2;
+  out_slot[0] = out_slot[1] = -1;
+  return true;
+}
+
 /// Triangulates the polygon of planes p[0 .. k) (counter-clockwise seen from outside) so
 /// that it is locally convex, as the dual hull is: Lawson flips from a fan (first in plain
 /// doubles, a prediction, then exactly from the triangulation they give). The diagonal
@@ -4216,6 +4268,9 @@ bool triangulate_polygon(const Planes& planes, const PrecisePlanes& precise,
     return true;
   }
   if (!split) return false;
+  if (k == 4 && planes[p[0]].fast && planes[p[1]].fast && planes[p[2]].fast && planes[p[3]].fast)
+    return triangulate_quadrilateral(planes, precise, known, p, base, out, out_across, out_side,
+                                     store, out_slot, out_far);
   auto& triangle = scratch.triangle;
   // Each triangle's vertex, computed where it is tested (ready); those go to the store at the
   // end, the others are made where the check or the repair needs them.
