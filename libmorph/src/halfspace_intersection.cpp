@@ -660,12 +660,6 @@ void take_known(const KnownPoints& known, HVertex& v) {
   const int k = known.common(v.planes[0], v.planes[1], v.planes[2]);
   if (k >= 0) set_known(known, k, v);
 }
-/// The vertex of three planes, from a known point where there is one (take_known).
-HVertex vertex_of(const Planes& planes, const std::array<int, 3>& abc, const KnownPoints& known) {
-  HVertex v = vertex_of(planes, abc);
-  take_known(known, v);
-  return v;
-}
 
 /// The vertex of three planes whose normals are known to be independent (det > 0, checked
 /// exactly): a known point on all three is taken as it is, without the meet's intervals
@@ -673,7 +667,7 @@ HVertex vertex_of(const Planes& planes, const std::array<int, 3>& abc, const Kno
 HVertex independent_vertex_of(const Planes& planes, const std::array<int, 3>& abc,
                               const KnownPoints& known) {
   const int k = known.empty() ? -1 : known.common(abc[0], abc[1], abc[2]);
-  if (k < 0) return vertex_of(planes, abc, known);
+  if (k < 0) return vertex_of(planes, abc);  // (no known point: not looked for again)
   HVertex v;
   v.planes = abc;
   set_known(known, k, v);
@@ -4332,7 +4326,7 @@ bool triangulate_polygon(const Planes& planes, const PrecisePlanes& precise,
   // (Cross products of doubles are computed afresh: a dozen operations, fewer than a
   // cache's look-ups cost; icosphere_5120 erosion, the flips' vertices 7.2M to 5.5M
   // instructions.)
-  // Triangle t's vertex, as vertex_of(planes, abc, known) computes it.
+  // Triangle t's vertex, as vertex_of(planes, abc) and take_known compute it.
   const auto compute_vertex = [&](int t) {
     ready[t] = 1;
     const auto [i, j, l] = triangle[t];
