@@ -426,6 +426,17 @@ MaybePolytope intersect(const ErosionInput& in, const IntersectOptions& options)
   return intersect_halfspaces(in.halfspaces, in.hint, options, in.known, in.expected);
 }
 
+/// A's vertex fans as the polygons of a guess, with A's edges between their facets (each
+/// polygon's sides joined by edge, ExpectedVertices::edge).
+ExpectedVertices fans_of(const Polytope& A) {
+  ExpectedVertices fans;
+  fans.begin = A.fan_begin;
+  fans.facets = A.fan_face;
+  fans.edge = A.fan_edge;
+  fans.edges = A.num_edges();
+  return fans;
+}
+
 }  // namespace
 
 MaybePolytope erode_polytope(const Polytope& A, const Polytope& B,
@@ -433,13 +444,10 @@ MaybePolytope erode_polytope(const Polytope& A, const Polytope& B,
   // Facet f of A is half-space f: A's fans are the polygons of the guess. The input is
   // shared with the result, whose lazy exact points (an opening) read its planes and known
   // points rather than copies.
-  const auto in = std::make_shared<const ErosionInput>(erosion_input(A, B, SumOfB::no,
-                                                                     {.begin = A.fan_begin,
-                                                                      .facets = A.fan_face,
-                                                                      .fans_of_operand = true,
-                                                                      .moved_by = {},
-                                                                      .edge = A.fan_edge,
-                                                                      .edges = A.num_edges()}));
+  ExpectedVertices guess = fans_of(A);
+  guess.fans_of_operand = true;
+  const auto in =
+      std::make_shared<const ErosionInput>(erosion_input(A, B, SumOfB::no, std::move(guess)));
   return intersect_halfspaces(in->halfspaces, in->hint, options, in->known, in->expected, in);
 }
 
@@ -455,12 +463,9 @@ ErosionInput erode_sum_input(const Polytope& S, const Polytope& A, const Polytop
     if (S.face_source[g] < A.num_faces()) facet_of[S.face_source[g]] = g;
   ExpectedVertices expected;
   if (std::find(facet_of.begin(), facet_of.end(), -1) == facet_of.end()) {
-    expected.begin = A.fan_begin;
+    expected = fans_of(A);
     expected.split = false;
-    expected.facets.reserve(A.fan_face.size());
-    for (int f : A.fan_face) expected.facets.push_back(facet_of[f]);
-    expected.edge = A.fan_edge;
-    expected.edges = A.num_edges();
+    for (int& f : expected.facets) f = facet_of[f];
   }
   return erosion_input(S, B, S.sum_pairs.empty() ? SumOfB::no : SumOfB::yes, std::move(expected));
 }
@@ -730,11 +735,8 @@ std::optional<ErosionInput> closing_input(const SumFacets& sum, const Polytope& 
       Cycles{sum.face_begin, corner_vertex, static_cast<int>(pairs.size())}, true, A.num_vertices(),
       pair_of, point_of, false, contributing, [&](int g) { return others[g]; }, on_plane);
   // A's vertices, each with S's facets of its facets around it (the same facets by index).
-  in.expected.begin = A.fan_begin;
+  in.expected = fans_of(A);
   in.expected.split = false;
-  in.expected.facets = A.fan_face;
-  in.expected.edge = A.fan_edge;
-  in.expected.edges = A.num_edges();
   // The hint erode gives S: its vertex centroid (the rounded sums) minus B's.
   V3<double> ca{0, 0, 0}, cb{0, 0, 0};
   for (const std::uint64_t key : pairs) {
