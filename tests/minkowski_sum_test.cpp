@@ -184,6 +184,9 @@ void check_sum(const Mesh& A, const Mesh& B, const std::string& name) {
   const std::string clean = clean_mesh_problem(
       S.mesh, planar_operands && feature.empty() ? clean_options_for(want) : kRoundedClean);
   CHECK_MESSAGE(clean.empty(), clean);
+  // A result is an operand the library itself accepts (pipelines chain on rounded meshes).
+  const morph::CheckResult operand = morph::check_convex_polyhedron(S.mesh);
+  CHECK_MESSAGE(operand.ok(), "not a valid operand: ", operand.problem);
 }
 
 struct Pair {

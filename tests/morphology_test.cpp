@@ -89,6 +89,9 @@ void check_clean(const MorphResult& r, const CleanOptions& options = kRoundedCle
   REQUIRE_FALSE(r.is_empty());
   const std::string problem = clean_mesh_problem(r.mesh, options);
   CHECK_MESSAGE(problem.empty(), problem);
+  // A result is an operand the library itself accepts (pipelines chain on rounded meshes).
+  const CheckResult operand = check_convex_polyhedron(r.mesh);
+  CHECK_MESSAGE(operand.ok(), "not a valid operand: ", operand.problem);
 }
 
 // Runs `op` and checks it left its inputs alone.
@@ -410,6 +413,36 @@ TEST_CASE("morph: eroding a dilation gives A back") {
       CHECK_MESSAGE(diff.empty(), diff);
     }
   }
+}
+
+TEST_CASE("morph: a facet far below the area tolerance is kept, and the result chains") {
+  // The cube [-1, 1]^3 with its corner (1, 1, 1) cut off by x + y + z <= 3 - d, eroded by
+  // the octahedron of radius 1/4: every plane moves in by 1/4, so the cut shrinks from
+  // d = 1/2 + 2^-24 deep to 2^-24 (in x + y + z): a triangle of edge 8.4e-8, twice its area
+  // 6.2e-15 against D^2 = 6.75. It is an exact facet of the erosion (well above the feature
+  // tolerance, 1e-11 D), and the eroded mesh must be an operand again.
+  const double cut = std::ldexp(1.0, -24), d = 0.5 + cut;
+  std::vector<Point> a_points, e_points;
+  for (int k = 0; k < 7; ++k) {
+    const Point c(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1);
+    a_points.push_back(c);
+    e_points.push_back(c * 0.75);
+  }
+  a_points.insert(a_points.end(), {Point(1, 1, 1 - d), Point(1, 1 - d, 1), Point(1 - d, 1, 1)});
+  e_points.insert(e_points.end(), {Point(0.75, 0.75, 0.75 - cut), Point(0.75, 0.75 - cut, 0.75),
+                                   Point(0.75 - cut, 0.75, 0.75)});
+  const Mesh A = convex_hull_mesh(a_points), B = octahedron(0.25);
+  const MorphResult e = run_erode(A, B);
+  check_clean(e, CleanOptions{});  // exact coordinates: every check exact
+  const std::string diff = compare_exact(describe(e.mesh), describe(convex_hull_mesh(e_points)));
+  CHECK_MESSAGE(diff.empty(), diff);
+  // Chained: dilated (the opening, through a mesh), opened, eroded again.
+  const double diag = bbox_diagonal(A);
+  const MorphResult de = run_dilate(e.mesh, B);
+  check_clean(de);
+  CHECK(max_excess(describe(de.mesh), describe(A)) <= kChainedTol * diag);
+  check_clean(run_open(e.mesh, B));
+  check_clean(run_erode(e.mesh, octahedron(0.125)));
 }
 
 TEST_CASE("morph: opening is inside A and idempotent; dilating an erosion stays inside A") {

@@ -30,9 +30,21 @@ namespace {
 // (a convex body measured from an interior point has no cancellation at all, ratio 1).
 constexpr double kFlatVolumeRatio = 1e-12;
 
-// A face whose Newell normal (twice its area) is below this fraction of D^2 has zero
-// area up to rounding: exactly collinear points computed in double give ~1e-16 D^2.
+// A face whose Newell normal (twice its area) is below this fraction of D^2 has zero area up
+// to rounding (exactly collinear points computed in double give ~1e-16 D^2), unless it is
+// small and well shaped (kSmallFaceShape).
 constexpr double kZeroAreaRatio = 1e-14;
+
+// A face below kZeroAreaRatio D^2 still has area when it is small and well shaped: its width
+// (twice its area over its longest edge L) at least kSmallFaceShape L and kZeroAreaRatio D.
+// Points computed in double lie within ~1e-16 D of their place, so such a face's normal
+// tilts by at most ~1e-16 D / width, and its heights across it (the planarity and convexity
+// tests, at kPlanarityTolerance D) err by ~1e-16 D L / width <= 1e-12 D, as a large face's
+// do. An exact result has such facets: an erosion's where three planes cut a corner a few
+// 1e-8 D across. A long thin face (box:1,1e6,1e-6's sides) stays degenerate: its normal is
+// not known to the tolerance. The faces' fast paths test kZeroAreaRatio D^2 only; a face
+// below it (rare) takes the general path, which applies both.
+constexpr double kSmallFaceShape = 1e-4;
 
 enum class Verdict { ok, invalid, inverted, not_convex };
 
@@ -931,8 +943,14 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
       if (has_equal_pair(n, [&](int i) -> const Point& { return m.points[ids[i]]; }))
         return fail(Verdict::invalid, face() + " has two vertices at the same position");
       const double length = plane.normal.norm();
-      if (!(length > zero_area))
-        return fail(Verdict::invalid, face() + " has zero area (its vertices are collinear)");
+      if (!(length > zero_area)) {
+        double longest = 0;  // squared
+        for (int k = 0; k < n; ++k)
+          longest = std::max(longest, (m.points[ids[k]] - m.points[ids[(k + 1) % n]]).sqrnorm());
+        if (!(length > kSmallFaceShape * longest &&
+              length > kZeroAreaRatio * diagonal * std::sqrt(longest)))
+          return fail(Verdict::invalid, face() + " has zero area (its vertices are collinear)");
+      }
       if (unit) {
         // The corners relative to the centroid, as newell_plane() computed them.
         double magnitude = 0, first = 0, previous = 0;
