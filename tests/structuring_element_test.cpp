@@ -287,7 +287,7 @@ TEST_CASE("se: every bad spec is an input_error listing the valid forms") {
                            "sphere=1",
                            "icosahedron:r=1e300",
                            "cylinder:r=1,h=288888888888888888888888888888,n=8",
-                           "box:1,1e6,1e-6"})
+                           "box:1,1e9,1e-9"})
     check_bad_spec(spec);
 }
 

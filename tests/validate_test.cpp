@@ -198,7 +198,7 @@ TEST_CASE("validate: a zero-area face is degenerate") {
   CHECK(contains(result.problem, "face 1 has zero area"));
   CHECK_FALSE(morph::check_convex_polyhedron(mesh).ok());
   check_rejected_as_invalid(mesh, "A: face 1 has zero area");
-  // Off the line by 1e-15: thin for its length as well as below 1e-14 D^2, still zero area.
+  // Off the line by 1e-15, below the width tolerance (1e-14 D): still zero area.
   std::vector<Point> thin = points;
   thin[B] = Point(1, 1e-15, 0);
   const Mesh nearly = mesh_of(thin, {{A, D, C}, {A, C, B}, {A, B, C, E}, {C, D, E}, {D, A, E}});
@@ -206,10 +206,9 @@ TEST_CASE("validate: a zero-area face is degenerate") {
 }
 
 TEST_CASE("validate: a face that is small but not thin has area") {
-  // The unit cube with its corner (1, 1, 1) cut off 2^-24 deep: the cut is a well-shaped
-  // triangle of edge 8.4e-8, twice its area 6.2e-15, below 1e-14 D^2 = 3e-14, but 7.3e-8
-  // wide, 0.87 of its edge. It is a proper face (an erosion makes such facets: see
-  // morphology_test.cpp). A long one as thin is not (box:1,1e6,1e-6, structuring_element_test).
+  // The unit cube with its corner (1, 1, 1) cut off 2^-24 deep: the cut is a triangle of
+  // edge 8.4e-8, twice its area 6.2e-15, below 1e-14 D^2 = 3e-14 but 7.3e-8 wide. It is a
+  // proper face (an erosion makes such facets: see morphology_test.cpp).
   const double d = std::ldexp(1.0, -24);
   std::vector<Point> points;
   for (int k = 0; k < 7; ++k) points.emplace_back(k & 1, k >> 1 & 1, k >> 2 & 1);

@@ -30,21 +30,14 @@ namespace {
 // (a convex body measured from an interior point has no cancellation at all, ratio 1).
 constexpr double kFlatVolumeRatio = 1e-12;
 
-// A face whose Newell normal (twice its area) is below this fraction of D^2 has zero area up
-// to rounding (exactly collinear points computed in double give ~1e-16 D^2), unless it is
-// small and well shaped (kSmallFaceShape).
+// A face whose width, twice its area (its Newell normal's length) over its longest edge, is at
+// most this fraction of D has zero area: its vertices are collinear up to rounding (points
+// computed in double on one line lie within ~1e-16 D of it). Width, not area against D^2: an
+// exact result's facet may be small (an erosion's, where three planes cut a corner a few
+// 1e-8 D across) or thin (an opening's edge facet, 1e-4 D long and 4e-10 D wide), and still a
+// proper face. The longest edge is at most D, so a face above kZeroAreaRatio D^2 passes: the
+// faces' fast paths test that alone, and send a face below it (rare) to the general path.
 constexpr double kZeroAreaRatio = 1e-14;
-
-// A face below kZeroAreaRatio D^2 still has area when it is small and well shaped: its width
-// (twice its area over its longest edge L) at least kSmallFaceShape L and kZeroAreaRatio D.
-// Points computed in double lie within ~1e-16 D of their place, so such a face's normal
-// tilts by at most ~1e-16 D / width, and its heights across it (the planarity and convexity
-// tests, at kPlanarityTolerance D) err by ~1e-16 D L / width <= 1e-12 D, as a large face's
-// do. An exact result has such facets: an erosion's where three planes cut a corner a few
-// 1e-8 D across. A long thin face (box:1,1e6,1e-6's sides) stays degenerate: its normal is
-// not known to the tolerance. The faces' fast paths test kZeroAreaRatio D^2 only; a face
-// below it (rare) takes the general path, which applies both.
-constexpr double kSmallFaceShape = 1e-4;
 
 enum class Verdict { ok, invalid, inverted, not_convex };
 
@@ -947,8 +940,7 @@ Finding nondegenerate(const MeshView& m, double relative_tolerance, Geometry& ge
         double longest = 0;  // squared
         for (int k = 0; k < n; ++k)
           longest = std::max(longest, (m.points[ids[k]] - m.points[ids[(k + 1) % n]]).sqrnorm());
-        if (!(length > kSmallFaceShape * longest &&
-              length > kZeroAreaRatio * diagonal * std::sqrt(longest)))
+        if (!(length > kZeroAreaRatio * diagonal * std::sqrt(longest)))
           return fail(Verdict::invalid, face() + " has zero area (its vertices are collinear)");
       }
       if (unit) {

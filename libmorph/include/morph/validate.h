@@ -5,8 +5,7 @@
 // The convexity rule, stated once:
 //   1. the mesh is non-empty, closed (every edge has two faces), 2-manifold (edges and
 //      vertices), connected, of genus 0, and every face has >= 3 distinct vertices and
-//      non-zero area (twice its area above 1e-14 D^2, or, for a small face, a width, twice
-//      its area over its longest edge, of at least 1e-4 of that edge and 1e-14 D: not
+//      non-zero area (its width, twice its area over its longest edge, above 1e-14 D: not
 //      collinear up to rounding); its size (bounding-box diagonal) lies in
 //      [kMinSize, kMaxSize];
 //   2. faces are consistently oriented with outward normals (positive volume);
