@@ -786,6 +786,7 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
   // vertex), with their group's largest facet: the only ones whose corners need a test. A
   // facet left as it is has no test when nothing merges either (the soup is kept then).
   std::vector<std::pair<int, int>> to_test;
+  bool dropped = false;  // a polygon kept fewer than three corners (see below)
   // Plain pointers: the writes through them could alias the vectors' own pointers, which
   // would then be loaded again for each corner.
   const int* const vertex = soup.vertex.data();
@@ -890,8 +891,30 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
       if (walked != boundary) return false;
     }
     const int d = size - first;
-    if (before_first >= 0 && d > 0) lengthen(size - 1, before_first);  // the chain wraps
-    if (d < 3) return false;
+    if (d < 3) {
+      // Fewer than three corners kept: each vertex that goes has fewer than three groups
+      // around it, where a small facet lies between facets that merged, nearly coplanar (an
+      // opening by a tiny element: a facet a few 1e-8 across at a crease whose two sides each
+      // merged). The merged facets at those vertices stay as they are in the next try, so the
+      // vertices keep their three groups; the rest of this walk goes on, to mark every such
+      // place in one try. Nothing to mark: the caller's fallback.
+      if (alone_only.empty()) alone_only.assign(nf, 0);
+      for (int f = g; f >= 0; f = groups.next_member[f])
+        for (int c = soup.begin[f]; c < soup.begin[f + 1]; ++c) {
+          if (kept[vertex[c]]) continue;
+          int e = c, steps = 0;
+          do {
+            const int h = k.face[e];
+            if (groups.of[h] != h || groups.next_member[h] >= 0) alone_only[h] = 1;
+            e = k.twin[k.prev[e]];
+          } while (e != c && ++steps <= nc);
+        }
+      dropped = true;
+      if (!to_test.empty() && to_test.back().first == polygons) to_test.pop_back();
+      size = first;
+      continue;
+    }
+    if (before_first >= 0) lengthen(size - 1, before_first);  // the chain wraps
     out.begin[++polygons] = size;
   }
   out.begin.resize(polygons + 1);
@@ -910,7 +933,7 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
       }
     }
   });
-  if (!convex.load()) {
+  if (!convex.load() || dropped) {
     // Coplanar within the tolerance, yet their union bends by more than it (thin facets
     // of an opening's tiny eroded edges beside a large facet): those groups' facets stay
     // as they are in the next try. A facet alone that loses a vertex cannot be helped so.
@@ -1057,10 +1080,13 @@ bool convex_around(const std::vector<V3<double>>& points, const Soup& soup, cons
   return true;
 }
 
-// Tries of merge_coplanar, each leaving the facets of the groups whose polygons were not
-// convex as they are (one try found them all in every case seen: the opening of icosphere
-// level 5 by its rotated copy scaled by 1/4 left one group).
-constexpr int kMergeRounds = 4;
+// Tries of merge_coplanar, each leaving as they are the facets of the groups whose polygons
+// were not convex, and the merged facets where a polygon kept fewer than three corners. A
+// try goes on only while that set grows. The opening of icosphere level 5 by its rotated
+// copy scaled by 1/4 took two tries; openings of random hulls of 16,000 to 64,000 points by
+// random ones at 1e-5 of their size took up to six (each try leaves fewer groups bending,
+// as the groups left re-form without the facets set aside).
+constexpr int kMergeRounds = 16;
 
 std::optional<std::pair<Soup, Connectivity>> simplify(const std::vector<V3<double>>& points,
                                                       Soup& soup, double limit, bool strict,
