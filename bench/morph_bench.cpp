@@ -704,7 +704,7 @@ void run_morph_scaling(const Settings& settings, Report& report) {
     // What the opening's own dilation takes of the plain dilation's time, at the largest size.
     if (!second_step.empty() && times[0].back() > 0)
       table.notes.push_back("- " + plan.series +
-                            ", largest: the opening's dilation of A - B alone " + "takes " +
+                            ", largest: the opening's dilation of A - B alone takes " +
                             ratio(second_step.back() / times[0].back()) + " the time of A (+) B");
   }
   table.notes.push_back(

@@ -683,10 +683,12 @@ struct MergedTwins {
 
 /// Passes 2 and 3 on a closed manifold soup: the polygons of its coplanar groups go to
 /// `out` (`changed` tells whether any merged; `out` is untouched if not). False when a
-/// group is not one disc or its polygon is not convex; `strict`: also when a needle finds
-/// no group. `geo`: each facet's geometry. Where a merged group's polygon is not convex,
-/// its facets are marked in `alone_only` (group_coplanar), for the caller to try again
-/// with them left as they are (and `passed` as this call leaves it).
+/// group is not one disc, its polygon is not convex or keeps fewer than three corners;
+/// `strict`: also when a needle finds no group. `geo`: each facet's geometry. Where a merged
+/// group's polygon is not convex, its facets are marked in `alone_only` (group_coplanar),
+/// and where a polygon keeps fewer than three corners, the merged facets around the corners
+/// it lost: for the caller to try again with them left as they are (and `passed` as this
+/// call leaves it).
 bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, const Connectivity& k,
                     std::optional<PassedEdges>& passed, const FacetGeometry* geo, double limit,
                     bool strict, Soup& merged, MergedTwins& merged_twins, bool& changed,
@@ -936,7 +938,7 @@ bool merge_coplanar(const std::vector<V3<double>>& points, const Soup& soup, con
   if (!convex.load() || dropped) {
     // Coplanar within the tolerance, yet their union bends by more than it (thin facets
     // of an opening's tiny eroded edges beside a large facet): those groups' facets stay
-    // as they are in the next try. A facet alone that loses a vertex cannot be helped so.
+    // as they are in the next try, as the merged facets around lost corners (marked above).
     if (alone_only.empty()) alone_only.assign(nf, 0);
     for (std::size_t i = 0; i < to_test.size(); ++i) {
       const int g = groups.of[to_test[i].second];
