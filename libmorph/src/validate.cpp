@@ -34,7 +34,7 @@ constexpr double kFlatVolumeRatio = 1e-12;
 // most this fraction of D has zero area: its vertices are collinear up to rounding (points
 // computed in double on one line lie within ~1e-16 D of it). Width, not area against D^2: an
 // exact result's facet may be small (an erosion's, where three planes cut a corner a few
-// 1e-8 D across) or thin (an opening's edge facet, 1e-4 D long and 4e-10 D wide), and still a
+// 1e-8 D across) or thin (an opening's edge facet, 2e-5 D long and 4e-10 D wide), and still a
 // proper face. The longest edge is at most D, so a face above kZeroAreaRatio D^2 passes: the
 // faces' fast paths test that alone, and send a face below it (rare) to the general path.
 constexpr double kZeroAreaRatio = 1e-14;
